@@ -334,14 +334,19 @@ class Camera:
         self.half_h = math.tan(math.radians(cam["fov"]) / 2)
         self.half_w = self.half_h * W / H
 
-    def rays(self):
+    def rays(self, ss=1):
+        """One ray through each pixel centre (ss=1), or ss x ss stratified sub-pixel
+        centres per pixel (pixel index = ray index // ss^2) for pixel-area averages."""
         W, H = self.W, self.H
         y, x = np.mgrid[0:H, 0:W]
-        u = (2 * (x.ravel() + 0.5) / W - 1) * self.half_w
-        v = (1 - 2 * (y.ravel() + 0.5) / H) * self.half_h
+        j, i = np.mgrid[0:ss, 0:ss]
+        fx = (x.ravel()[:, None] + (i.ravel()[None] + 0.5) / ss).ravel()
+        fy = (y.ravel()[:, None] + (j.ravel()[None] + 0.5) / ss).ravel()
+        u = (2 * fx / W - 1) * self.half_w
+        v = (1 - 2 * fy / H) * self.half_h
         d = self.fwd[None] + u[:, None] * self.right[None] + v[:, None] * self.up[None]
         d /= np.linalg.norm(d, axis=1, keepdims=True)
-        o = np.repeat(self.pos[None], W * H, axis=0)
+        o = np.repeat(self.pos[None], len(d), axis=0)
         return o, d
 
     def pixel_area(self):
@@ -349,17 +354,17 @@ class Camera:
 
 
 # ----------------------------------------------------------------------------- eye paths
-def trace_eye(scene, geo, cam):
+def trace_eye(scene, geo, cam, ss=1):
     """Deterministic eye-path tree. Returns images (direct, background) and the diffuse
     vertices (pixel, weight, p, obj, albedo, nspec) at which caustics must be gathered."""
     W, H = cam.W, cam.H
     direct = np.zeros((W * H, 3))
     backgr = np.zeros((W * H, 3))
-    o, d = cam.rays()
-    pix = np.arange(W * H)
-    w = np.ones((W * H, 3))
-    nspec = np.zeros(W * H, np.int64)
-    medium = np.full(W * H, -1, np.int64)
+    o, d = cam.rays(ss)
+    pix = np.arange(len(d)) // (ss * ss)
+    w = np.full((len(d), 3), 1.0 / (ss * ss))
+    nspec = np.zeros(len(d), np.int64)
+    medium = np.full(len(d), -1, np.int64)
     verts = []
     objs = scene["objects"]
     max_depth = scene["max_depth"]
@@ -662,12 +667,12 @@ def init_mitsuba():
     mi.set_variant("llvm_ad_rgb")
 
 
-def render(scene, W, H, photons, seed, radius, batch=1_000_000, splat=True, quiet=False):
+def render(scene, W, H, photons, seed, radius, batch=1_000_000, splat=True, quiet=False, ss=1):
     init_mitsuba()
     t0 = time.time()
     geo = Geometry(scene)
     cam = Camera(scene["camera"], W, H)
-    direct, backgr, V, eye_rays = trace_eye(scene, geo, cam)
+    direct, backgr, V, eye_rays = trace_eye(scene, geo, cam, ss)
     t_eye = time.time() - t0
     if not quiet:
         log(f"eye paths: {eye_rays} rays, {len(V['pix'])} diffuse vertices, {t_eye:.1f}s")
@@ -712,24 +717,25 @@ def load_scene(path):
 
 
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if "--check" in argv:
+        import check
+        return check.main([a for a in argv if a != "--check"])
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene", nargs="?")
     ap.add_argument("-o", "--output")
     ap.add_argument("--width", type=int, default=160)
     ap.add_argument("--height", type=int, default=120)
-    ap.add_argument("--photons", type=int, default=100_000_000, help="photons emitted per light (into the cones around the specular objects)")
+    ap.add_argument("--photons", type=int, default=60_000_000, help="photons emitted per light (into the cones around the specular objects)")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--radius", type=float, default=0.01, help="gather kernel radius (scene units)")
+    ap.add_argument("--radius", type=float, default=0.015, help="gather kernel radius (scene units)")
     ap.add_argument("--batch", type=int, default=1_000_000)
     ap.add_argument("--parts-prefix")
+    ap.add_argument("--supersample", type=int, default=1, metavar="K",
+                    help="K x K eye rays per pixel (pixel-area average); 1 = one ray through the centre, as caustic")
     ap.add_argument("--no-splat", action="store_true")
     ap.add_argument("--check", action="store_true", help="run the self-checks (check.py) instead")
-    args, rest = ap.parse_known_args(argv)
-    if args.check:
-        import check
-        return check.main(rest)
-    if rest:
-        ap.error(f"unrecognised arguments: {' '.join(rest)}")
+    args = ap.parse_args(argv)
     if not args.scene or not args.output:
         ap.error("SCENE and -o OUT.pfm are required")
     try:
@@ -738,7 +744,7 @@ def main(argv=None):
         log(f"error: {args.scene}: {e}")
         return 2
     full, parts, stats = render(scene, args.width, args.height, args.photons, args.seed, args.radius,
-                                batch=args.batch, splat=not args.no_splat)
+                                batch=args.batch, splat=not args.no_splat, ss=args.supersample)
     write_pfm(args.output, full, args.width, args.height)
     if args.parts_prefix:
         for k, v in parts.items():
