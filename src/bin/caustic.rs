@@ -1,0 +1,274 @@
+//! `caustic`: render a scene file to PNG/PFM, or compare two PFM images.
+//!
+//! ```text
+//! caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
+//!                [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
+//!                [--alpha A] [--cone-filter K] [--seed S] [--threads T]
+//!                [--exposure E] [--stats] [--quiet]
+//! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F]
+//! ```
+//! Exit status: 0 on success, 2 on bad input (scene, flags, files), 1 otherwise.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use caustic::desktop::image::{compare, mask_above, Image};
+use caustic::desktop::{load_scene, render, RenderOptions, RenderStats};
+use caustic::photon::{ConeFilter, PhotonSettings};
+use caustic::raster::ToneMap;
+
+const USAGE: &str = "usage:
+  caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
+                 [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
+                 [--alpha A] [--cone-filter K] [--seed S] [--threads T]
+                 [--exposure E] [--stats] [--quiet]
+  caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F]";
+
+/// A failure and its exit status.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn bad_input(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("render") => cmd_render(&args[1..]),
+        Some("compare") => cmd_compare(&args[1..]),
+        Some("-h" | "--help" | "help") => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        _ => Err(bad_input(USAGE)),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("caustic: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+/// Flags as `--name value` pairs and bare switches, after positional arguments.
+struct Flags<'a> {
+    args: &'a [String],
+    used: Vec<bool>,
+}
+
+impl<'a> Flags<'a> {
+    fn new(args: &'a [String]) -> Self {
+        Self {
+            args,
+            used: vec![false; args.len()],
+        }
+    }
+
+    fn switch(&mut self, name: &str) -> bool {
+        match self.args.iter().position(|a| a == name) {
+            Some(i) => {
+                self.used[i] = true;
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn value<T: std::str::FromStr>(&mut self, names: &[&str]) -> Result<Option<T>, Failure> {
+        let Some(i) = self.args.iter().position(|a| names.contains(&a.as_str())) else {
+            return Ok(None);
+        };
+        self.used[i] = true;
+        let v = self
+            .args
+            .get(i + 1)
+            .ok_or_else(|| bad_input(format!("{} needs a value", names[0])))?;
+        self.used[i + 1] = true;
+        v.parse()
+            .map(Some)
+            .map_err(|_| bad_input(format!("{}: cannot parse \"{v}\"", names[0])))
+    }
+
+    /// The positional arguments left, or an error naming an unknown flag.
+    fn positional(self) -> Result<Vec<&'a String>, Failure> {
+        let mut out = Vec::new();
+        for (a, used) in self.args.iter().zip(self.used) {
+            if used {
+                continue;
+            }
+            if a.starts_with("--") || (a.starts_with('-') && a.len() > 1) {
+                return Err(bad_input(format!("unknown option {a}\n{USAGE}")));
+            }
+            out.push(a);
+        }
+        Ok(out)
+    }
+}
+
+fn cmd_render(args: &[String]) -> Result<(), Failure> {
+    let t0 = Instant::now();
+    let mut f = Flags::new(args);
+    let out: Option<PathBuf> = f.value(&["-o", "--output"])?;
+    let pfm: Option<PathBuf> = f.value(&["--pfm"])?;
+    let width: Option<u32> = f.value(&["--width"])?;
+    let height: Option<u32> = f.value(&["--height"])?;
+    let photons: Option<u32> = f.value(&["--photons"])?;
+    let k: Option<u32> = f.value(&["--k"])?;
+    let radius: Option<f32> = f.value(&["--radius"])?;
+    let max_depth: Option<u32> = f.value(&["--max-depth"])?;
+    let passes: Option<u32> = f.value(&["--passes"])?;
+    let alpha: Option<f32> = f.value(&["--alpha"])?;
+    let cone: Option<f32> = f.value(&["--cone-filter"])?;
+    let seed: u64 = f.value(&["--seed"])?.unwrap_or(0);
+    let threads: Option<usize> = f.value(&["--threads"])?;
+    let exposure: f32 = f.value(&["--exposure"])?.unwrap_or(1.0);
+    let want_stats = f.switch("--stats");
+    let quiet = f.switch("--quiet");
+    let pos = f.positional()?;
+    let [scene_path] = pos.as_slice() else {
+        return Err(bad_input(format!("render takes one scene file\n{USAGE}")));
+    };
+    if out.is_none() && pfm.is_none() {
+        return Err(bad_input("render needs -o OUT.png and/or --pfm OUT.pfm"));
+    }
+    let tone = ToneMap::new(exposure).map_err(|e| bad_input(format!("--exposure: {e}")))?;
+
+    let loaded =
+        load_scene(scene_path.as_ref()).map_err(|e| bad_input(format!("{scene_path}: {e}")))?;
+    let mut scene = loaded.scene;
+    if width.is_some() || height.is_some() {
+        let c = scene.camera();
+        let (w, h) = (width.unwrap_or(c.width()), height.unwrap_or(c.height()));
+        scene.set_camera(
+            c.with_size(w, h)
+                .map_err(|e| bad_input(format!("--width/--height: {e}")))?,
+        );
+    }
+    let p = loaded.photons;
+    let settings = PhotonSettings::new(
+        photons.unwrap_or(p.count()),
+        k.unwrap_or(p.k()),
+        radius.unwrap_or(p.max_radius()),
+        max_depth.unwrap_or(p.max_depth()),
+    )
+    .map_err(|e| bad_input(format!("photon flags: {e}")))?;
+    let cone = match cone {
+        Some(kc) => {
+            Some(ConeFilter::new(kc).ok_or_else(|| bad_input("--cone-filter must be ≥ 1"))?)
+        }
+        None => None,
+    };
+    let settings = settings.with_cone_filter(cone);
+    let alpha = alpha.unwrap_or(loaded.alpha);
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(bad_input("--alpha must lie in (0, 1)"));
+    }
+    let opts = RenderOptions {
+        seed,
+        threads: threads
+            .unwrap_or_else(caustic::desktop::run::available_threads)
+            .max(1),
+        progress: !quiet,
+        passes: passes.unwrap_or(loaded.passes).max(1),
+        alpha,
+    };
+    let parse_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let (image, stats) = render(&scene, &settings, &opts).map_err(|e| bad_input(e.to_string()))?;
+    let t_write = Instant::now();
+    if let Some(path) = &out {
+        image.write_png(path, &tone).map_err(|e| Failure {
+            code: 1,
+            message: format!("{}: {e}", path.display()),
+        })?;
+    }
+    if let Some(path) = &pfm {
+        image.write_pfm(path).map_err(|e| Failure {
+            code: 1,
+            message: format!("{}: {e}", path.display()),
+        })?;
+    }
+    let write_ms = t_write.elapsed().as_secs_f64() * 1e3;
+    if want_stats {
+        println!(
+            "{}",
+            stats_json(&stats, parse_ms, write_ms, t0.elapsed().as_secs_f64() * 1e3)
+        );
+    }
+    Ok(())
+}
+
+fn stats_json(s: &RenderStats, parse_ms: f64, write_ms: f64, total_ms: f64) -> String {
+    format!(
+        concat!(
+            "{{\"width\":{},\"height\":{},\"threads\":{},\"passes\":{},",
+            "\"time_ms\":{{\"parse\":{:.3},\"emit\":{:.3},\"balance\":{:.3},\"render\":{:.3},",
+            "\"gather_cpu\":{:.3},\"write\":{:.3},\"total\":{:.3}}},",
+            "\"rays\":{{\"eye\":{},\"shadow\":{}}},",
+            "\"photons\":{{\"emitted\":{},\"stored\":{}}}}}"
+        ),
+        s.width,
+        s.height,
+        s.threads,
+        s.passes,
+        parse_ms,
+        s.emit_ms,
+        s.balance_ms,
+        s.render_ms,
+        s.gather_cpu_ms,
+        write_ms,
+        total_ms,
+        s.rays.eye,
+        s.rays.shadow,
+        s.photons_emitted,
+        s.photons_stored
+    )
+}
+
+fn cmd_compare(args: &[String]) -> Result<(), Failure> {
+    let mut f = Flags::new(args);
+    let mask_path: Option<PathBuf> = f.value(&["--mask"])?;
+    let fraction: f32 = f.value(&["--mask-fraction"])?.unwrap_or(0.1);
+    let pos = f.positional()?;
+    let [a, b] = pos.as_slice() else {
+        return Err(bad_input(format!("compare takes two PFM files\n{USAGE}")));
+    };
+    let read = |p: &String| Image::read_pfm(p.as_ref()).map_err(|e| bad_input(e.to_string()));
+    let (a, b) = (read(a)?, read(b)?);
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(bad_input(format!(
+            "sizes differ: {}×{} vs {}×{}",
+            a.width, a.height, b.width, b.height
+        )));
+    }
+    let full = compare(&a, &b, None).ok_or_else(|| bad_input("empty images"))?;
+    let mut json = format!(
+        "{{\"rel_rmse\":{:.6},\"rel_mae\":{:.6},\"pixels\":{}",
+        full.rel_rmse, full.rel_mae, full.pixels
+    );
+    if let Some(m) = mask_path {
+        let m = Image::read_pfm(&m).map_err(|e| bad_input(e.to_string()))?;
+        if (m.width, m.height) != (a.width, a.height) {
+            return Err(bad_input("the mask's size differs from the images'"));
+        }
+        let mask = mask_above(&m, fraction);
+        match compare(&a, &b, Some(&mask)) {
+            Some(e) => {
+                json += &format!(
+                    ",\"mask\":{{\"rel_rmse\":{:.6},\"rel_mae\":{:.6},\"pixels\":{}}}",
+                    e.rel_rmse, e.rel_mae, e.pixels
+                )
+            }
+            None => json += ",\"mask\":null",
+        }
+    }
+    println!("{json}}}");
+    Ok(())
+}

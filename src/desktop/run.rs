@@ -1,0 +1,317 @@
+//! Rendering on the desktop: the photon array on the heap, rows over threads, progress.
+//!
+//! Rows are pure functions of `(scene, store, y)`, and the forward pass a pure function
+//! of `(scene, settings, seed, pass)`, so the image is bit-identical whatever the
+//! number of threads: threads only change the order in which rows are computed.
+
+use std::io::{IsTerminal, Write};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+use std::vec;
+
+use super::image::Image;
+use super::{DesktopScene, MAX_DEPTH, MAX_GATHER, MAX_PHOTONS};
+use crate::material::Classic;
+use crate::math::{Rgb, UnitVec3, Vec3};
+use crate::photon::{self, balance, photons_needed, CausticStore, KdTree, Photon, PhotonSettings};
+use crate::render::{RayCount, Renderer};
+use crate::Error;
+
+/// How to render on the desktop.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderOptions {
+    /// Seed of the forward pass.
+    pub seed: u64,
+    /// Worker threads (≥ 1).
+    pub threads: usize,
+    /// Draw a progress bar on stderr (only when it is a terminal).
+    pub progress: bool,
+    /// Progressive passes (Knaus & Zwicker 2011), ≥ 1.
+    pub passes: u32,
+    /// Radius shrink exponent α of the passes: `r_i² = r_1²·i^(α−1)`.
+    pub alpha: f32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            threads: available_threads(),
+            progress: false,
+            passes: 1,
+            alpha: 2.0 / 3.0,
+        }
+    }
+}
+
+/// The machine's parallelism.
+pub fn available_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// What a render did and how long each phase took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Threads used.
+    pub threads: usize,
+    /// Passes rendered.
+    pub passes: u32,
+    /// Photon emission and tracing, ms (all passes).
+    pub emit_ms: f64,
+    /// kd-tree balancing, ms.
+    pub balance_ms: f64,
+    /// The backward pass, wall ms (includes gathering).
+    pub render_ms: f64,
+    /// Time inside caustic gathers, summed over threads, ms of CPU.
+    pub gather_cpu_ms: f64,
+    /// Rays traced.
+    pub rays: RayCount,
+    /// Photons emitted.
+    pub photons_emitted: u64,
+    /// Photons stored (all passes).
+    pub photons_stored: u64,
+}
+
+/// A store that times its gathers (summed over threads).
+struct Timed<'a, S> {
+    inner: &'a S,
+    nanos: AtomicU64,
+}
+
+impl<S: CausticStore> CausticStore for Timed<'_, S> {
+    fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
+        let t = Instant::now();
+        let e = self.inner.irradiance(x, n);
+        self.nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        e
+    }
+    fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
+        let t = Instant::now();
+        let e = self.inner.classic(x, n, to_eye, m);
+        self.nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        e
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// The balanced photons of one forward pass, on the heap.
+#[derive(Debug)]
+pub struct PhotonPass {
+    photons: vec::Vec<Photon>,
+    unit: f32,
+    emitted: u64,
+}
+
+impl PhotonPass {
+    /// The balanced tree.
+    pub fn tree(&self) -> KdTree<'_> {
+        KdTree::from_balanced(&self.photons)
+    }
+
+    /// Power of one stored unit, W.
+    pub fn unit(&self) -> f32 {
+        self.unit
+    }
+
+    /// Photons emitted.
+    pub fn emitted(&self) -> u64 {
+        self.emitted
+    }
+}
+
+/// Runs forward pass `pass` into a heap array and balances it, adding the times to `stats`.
+pub fn photon_pass(
+    scene: &DesktopScene,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    stats: &mut RenderStats,
+) -> Result<PhotonPass, Error> {
+    let needed = photons_needed(scene, settings);
+    if needed > MAX_PHOTONS {
+        return Err(Error::Capacity {
+            what: "photons (count × lights)",
+            requested: needed,
+            capacity: MAX_PHOTONS,
+        });
+    }
+    let t = Instant::now();
+    let mut photons = vec![Photon::ZERO; needed];
+    let f = photon::shoot(scene, settings, seed, pass, &mut photons)?;
+    photons.truncate(f.stored);
+    stats.emit_ms += ms(t.elapsed());
+    let t = Instant::now();
+    balance(&mut photons);
+    stats.balance_ms += ms(t.elapsed());
+    stats.photons_emitted += f.emitted;
+    stats.photons_stored += f.stored as u64;
+    Ok(PhotonPass {
+        photons,
+        unit: f.power_unit,
+        emitted: f.emitted,
+    })
+}
+
+/// Renders `scene` with the forward and backward passes, on `opts.threads` threads.
+pub fn render(
+    scene: &DesktopScene,
+    settings: &PhotonSettings,
+    opts: &RenderOptions,
+) -> Result<(Image, RenderStats), Error> {
+    let cam = scene.camera();
+    let (w, h) = (cam.width(), cam.height());
+    let threads = opts.threads.max(1);
+    let passes = opts.passes.max(1);
+    let mut stats = RenderStats {
+        width: w,
+        height: h,
+        threads,
+        passes,
+        ..RenderStats::default()
+    };
+    let mut sum = Image::new(w, h);
+    let progress = Progress::new(
+        opts.progress && std::io::stderr().is_terminal(),
+        h as usize * passes as usize,
+    );
+    for pass in 0..passes {
+        // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
+        let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
+        let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
+        let photons = photon_pass(scene, &pass_settings, opts.seed, pass, &mut stats)?;
+        let store =
+            photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
+        let timed = Timed {
+            inner: &store,
+            nanos: AtomicU64::new(0),
+        };
+        let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
+            Renderer::new(scene, &timed, settings.max_depth())?;
+        let t = Instant::now();
+        let mut image = Image::new(w, h);
+        let rays = render_rows(&renderer, &mut image, threads, &progress);
+        stats.render_ms += ms(t.elapsed());
+        stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
+        stats.rays += rays;
+        if passes == 1 {
+            sum = image;
+        } else {
+            for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
+                *s += *p;
+            }
+        }
+    }
+    progress.finish();
+    if passes > 1 {
+        let inv = 1.0 / passes as f32;
+        for p in &mut sum.pixels {
+            *p = *p * inv;
+        }
+    }
+    Ok((sum, stats))
+}
+
+/// Renders all rows of `image` on `threads` threads, each taking the next free row.
+pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const D: usize>(
+    renderer: &Renderer<'_, S, O, L, D>,
+    image: &mut Image,
+    threads: usize,
+    progress: &Progress,
+) -> RayCount {
+    let width = image.width as usize;
+    let rows = Mutex::new(image.pixels.chunks_mut(width).enumerate());
+    let total = Mutex::new(RayCount::default());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                let mut mine = RayCount::default();
+                loop {
+                    let next = rows.lock().map(|mut r| r.next()).unwrap_or(None);
+                    let Some((y, row)) = next else { break };
+                    mine += renderer.row(y as u32, row);
+                    progress.tick();
+                }
+                if let Ok(mut t) = total.lock() {
+                    *t += mine;
+                }
+            });
+        }
+    });
+    total.into_inner().unwrap_or_default()
+}
+
+/// A progress bar on stderr, drawn by whichever worker finishes a row, at most ten
+/// times a second.
+#[derive(Debug)]
+pub struct Progress {
+    enabled: bool,
+    total: usize,
+    done: AtomicUsize,
+    start: Instant,
+    last_draw_ms: AtomicU64,
+}
+
+impl Progress {
+    /// A bar over `total` steps; draws nothing unless `enabled`.
+    pub fn new(enabled: bool, total: usize) -> Self {
+        Self {
+            enabled,
+            total: total.max(1),
+            done: AtomicUsize::new(0),
+            start: Instant::now(),
+            last_draw_ms: AtomicU64::new(0),
+        }
+    }
+
+    /// One step done.
+    pub fn tick(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if !self.enabled {
+            return;
+        }
+        let now = self.start.elapsed().as_millis() as u64;
+        let last = self.last_draw_ms.load(Ordering::Relaxed);
+        if now >= last + 100
+            && self
+                .last_draw_ms
+                .compare_exchange(last, now, Ordering::Relaxed, Ordering::Relaxed)
+                .is_ok()
+        {
+            self.draw(done);
+        }
+    }
+
+    fn draw(&self, done: usize) {
+        let frac = done as f64 / self.total as f64;
+        let filled = (frac * 30.0) as usize;
+        let bar: std::string::String = (0..30)
+            .map(|i| if i < filled { '#' } else { '-' })
+            .collect();
+        let mut err = std::io::stderr().lock();
+        let _ = write!(
+            err,
+            "\r[{bar}] {:5.1}%  {:.1}s",
+            frac * 100.0,
+            self.start.elapsed().as_secs_f64()
+        );
+        let _ = err.flush();
+    }
+
+    /// Completes the bar and ends its line.
+    pub fn finish(&self) {
+        if self.enabled {
+            self.draw(self.total);
+            let _ = writeln!(std::io::stderr());
+        }
+    }
+}

@@ -1,0 +1,302 @@
+//! Vectors, unit directions and colours: `f32` throughout, on scalar `glam` and `libm`.
+//!
+//! Every float operation the renderer performs goes through these types or through
+//! `libm`, never through the platform's own maths library, so that an x86-64 desktop
+//! and a Cortex-M4F compute the same bits. No `mul_add`: Rust never fuses `a * b + c`.
+
+use core::ops::{Add, AddAssign, Mul, MulAssign, Neg};
+
+use crate::error::{finite, Error};
+pub use glam::{Mat3, Vec3};
+
+/// A direction of unit length.
+///
+/// # Guarantees
+/// The components are finite and the length is 1 to within a few ulps. Constructors
+/// normalise; code that takes a `UnitVec3` never re-checks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitVec3(Vec3);
+
+impl UnitVec3 {
+    /// +X.
+    pub const X: Self = Self(Vec3::X);
+    /// +Y.
+    pub const Y: Self = Self(Vec3::Y);
+    /// +Z.
+    pub const Z: Self = Self(Vec3::Z);
+
+    /// Normalises `v`; `None` when it is zero, too small to normalise, or not finite.
+    #[inline]
+    pub fn new(v: Vec3) -> Option<Self> {
+        let len2 = v.length_squared();
+        if !(len2.is_finite() && len2 > 0.0) {
+            return None;
+        }
+        let u = v * (1.0 / libm::sqrtf(len2));
+        u.is_finite().then_some(Self(u))
+    }
+
+    /// Normalises `v`, or reports a [`Error::Degenerate`] direction named `what`.
+    pub fn try_new(v: Vec3, what: &'static str) -> Result<Self, Error> {
+        if !v.is_finite() {
+            return Err(Error::NotFinite { what });
+        }
+        Self::new(v).ok_or(Error::Degenerate { what })
+    }
+
+    /// Wraps a vector the caller knows to be of unit length (a normalised
+    /// combination of unit vectors, a basis vector). Checked in debug builds.
+    #[inline]
+    pub(crate) fn new_unchecked(v: Vec3) -> Self {
+        debug_assert!((v.length_squared() - 1.0).abs() < 1e-4, "not unit: {v:?}");
+        Self(v)
+    }
+
+    /// The vector.
+    #[inline]
+    pub fn get(self) -> Vec3 {
+        self.0
+    }
+
+    /// Dot product with any vector.
+    #[inline]
+    pub fn dot(self, v: Vec3) -> f32 {
+        self.0.dot(v)
+    }
+
+    /// Two unit vectors that complete `self` to a right-handed orthonormal basis
+    /// (Duff et al. 2017, "Building an Orthonormal Basis, Revisited"; no branch on
+    /// a threshold, continuous except at z = −1 exactly).
+    pub fn basis(self) -> (UnitVec3, UnitVec3) {
+        let n = self.0;
+        let sign = libm::copysignf(1.0, n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let t = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let s = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        (UnitVec3(t), UnitVec3(s))
+    }
+}
+
+impl Neg for UnitVec3 {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Self(-self.0)
+    }
+}
+
+/// Checks that every component of `v` is finite.
+pub(crate) fn finite_vec(v: Vec3, what: &'static str) -> Result<Vec3, Error> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::NotFinite { what })
+    }
+}
+
+/// The largest absolute component: the magnitude that float rounding scales with.
+#[inline]
+pub fn max_abs(v: Vec3) -> f32 {
+    v.abs().max_element()
+}
+
+/// Mirror reflection of the travel direction `d` about the normal `n`
+/// (paper eq. 1, written for a travel direction: `r = d − 2(n·d)n`).
+#[inline]
+pub fn reflect(d: UnitVec3, n: UnitVec3) -> UnitVec3 {
+    let v = d.get() - n.get() * (2.0 * n.dot(d.get()));
+    // Reflection preserves length; renormalise to keep the invariant exact over many bounces.
+    UnitVec3::new(v).unwrap_or(d)
+}
+
+/// Linear RGB: radiance, irradiance, power or a reflectance, per channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rgb {
+    /// Red.
+    pub r: f32,
+    /// Green.
+    pub g: f32,
+    /// Blue.
+    pub b: f32,
+}
+
+impl Rgb {
+    /// Black.
+    pub const ZERO: Self = Self::new(0.0, 0.0, 0.0);
+    /// White (1, 1, 1).
+    pub const ONE: Self = Self::new(1.0, 1.0, 1.0);
+
+    /// From three channels.
+    #[inline]
+    pub const fn new(r: f32, g: f32, b: f32) -> Self {
+        Self { r, g, b }
+    }
+
+    /// The same value in every channel.
+    #[inline]
+    pub const fn splat(v: f32) -> Self {
+        Self::new(v, v, v)
+    }
+
+    /// From an `[r, g, b]` array.
+    #[inline]
+    pub const fn from_array(a: [f32; 3]) -> Self {
+        Self::new(a[0], a[1], a[2])
+    }
+
+    /// As an `[r, g, b]` array.
+    #[inline]
+    pub const fn to_array(self) -> [f32; 3] {
+        [self.r, self.g, self.b]
+    }
+
+    /// The largest channel.
+    #[inline]
+    pub fn max_channel(self) -> f32 {
+        self.r.max(self.g).max(self.b)
+    }
+
+    /// The smallest channel.
+    #[inline]
+    pub fn min_channel(self) -> f32 {
+        self.r.min(self.g).min(self.b)
+    }
+
+    /// `true` when every channel is exactly zero (or negative).
+    #[inline]
+    pub fn is_black(self) -> bool {
+        self.max_channel() <= 0.0
+    }
+
+    /// `true` when every channel is finite.
+    #[inline]
+    pub fn is_finite(self) -> bool {
+        self.r.is_finite() && self.g.is_finite() && self.b.is_finite()
+    }
+
+    /// Rec. 709 luminance, for statistics and tests.
+    #[inline]
+    pub fn luminance(self) -> f32 {
+        0.2126 * self.r + 0.7152 * self.g + 0.0722 * self.b
+    }
+
+    /// `exp(−σ·t)` per channel: Beer–Lambert transmittance over a length `t`.
+    /// Costs three `expf` only when `self` (σ) is not black.
+    #[inline]
+    pub fn beer(self, t: f32) -> Rgb {
+        if self.is_black() {
+            return Rgb::ONE;
+        }
+        Rgb::new(
+            libm::expf(-self.r * t),
+            libm::expf(-self.g * t),
+            libm::expf(-self.b * t),
+        )
+    }
+
+    /// Checks that every channel is finite and at least zero.
+    pub fn validate(self, what: &'static str) -> Result<Self, Error> {
+        for c in self.to_array() {
+            if finite(c, what)? < 0.0 {
+                return Err(Error::OutOfRange {
+                    what,
+                    value: c,
+                    min: 0.0,
+                    max: f32::MAX,
+                });
+            }
+        }
+        Ok(self)
+    }
+
+    /// Checks that every channel is in `[0, 1]` (a reflectance or albedo).
+    pub fn validate_unit(self, what: &'static str) -> Result<Self, Error> {
+        for c in self.to_array() {
+            crate::error::in_range(c, 0.0, 1.0, what)?;
+        }
+        Ok(self)
+    }
+}
+
+impl Add for Rgb {
+    type Output = Rgb;
+    #[inline]
+    fn add(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r + o.r, self.g + o.g, self.b + o.b)
+    }
+}
+
+impl AddAssign for Rgb {
+    #[inline]
+    fn add_assign(&mut self, o: Rgb) {
+        *self = *self + o;
+    }
+}
+
+impl Mul for Rgb {
+    type Output = Rgb;
+    #[inline]
+    fn mul(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r * o.r, self.g * o.g, self.b * o.b)
+    }
+}
+
+impl MulAssign for Rgb {
+    #[inline]
+    fn mul_assign(&mut self, o: Rgb) {
+        *self = *self * o;
+    }
+}
+
+impl Mul<f32> for Rgb {
+    type Output = Rgb;
+    #[inline]
+    fn mul(self, s: f32) -> Rgb {
+        Rgb::new(self.r * s, self.g * s, self.b * s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_vectors_reject_degenerate_input() {
+        assert!(UnitVec3::new(Vec3::ZERO).is_none());
+        assert!(UnitVec3::new(Vec3::new(f32::NAN, 0.0, 1.0)).is_none());
+        assert!(UnitVec3::new(Vec3::new(f32::INFINITY, 0.0, 1.0)).is_none());
+        let u = UnitVec3::new(Vec3::new(3.0, 4.0, 0.0)).unwrap();
+        assert!((u.get().length() - 1.0).abs() < 1e-6);
+        // Tiny but representable vectors still normalise.
+        assert!(UnitVec3::new(Vec3::new(1e-18, 0.0, 0.0)).is_some());
+    }
+
+    #[test]
+    fn basis_is_orthonormal_everywhere() {
+        for &n in &[
+            Vec3::X,
+            Vec3::Y,
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(1.0, -2.0, 0.3),
+            Vec3::new(0.0, 0.0, -0.999_999),
+        ] {
+            let n = UnitVec3::new(n).unwrap();
+            let (t, s) = n.basis();
+            for (a, b) in [(t, s), (t, n), (s, n)] {
+                assert!(a.dot(b.get()).abs() < 1e-5, "{n:?}");
+            }
+            assert!((t.get().length() - 1.0).abs() < 1e-5 && (s.get().length() - 1.0).abs() < 1e-5);
+            // Right-handed: t × s = n.
+            assert!((t.get().cross(s.get()) - n.get()).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn reflection_mirrors_the_normal_component() {
+        let d = UnitVec3::new(Vec3::new(1.0, -1.0, 0.0)).unwrap();
+        let r = reflect(d, UnitVec3::Y);
+        assert!((r.get() - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-6);
+    }
+}

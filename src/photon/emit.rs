@@ -1,0 +1,286 @@
+//! Photon emission from a point light: directions and powers.
+//!
+//! **The paper's sphere, made uniform.** Paper eq. 7 places emission directions on the
+//! light's unit sphere, `P(u, v) = (cos v cos u, cos v sin u, sin v)`, stepping `u` and
+//! `v` uniformly — which crowds directions at the poles, where the circles of latitude
+//! are short. Here `u` is uniform in `[0, 2π)` and `v` is drawn *by its sine*,
+//! `sin v` uniform in `[−1, 1]` (Archimedes' hat-box theorem): every solid angle then
+//! receives the same share of photons, so each photon carries exactly `4π·I/N`.
+//!
+//! **Projection maps.** Photons are aimed only at objects that can focus light
+//! (Jensen 2001, §7.1; here with bounding spheres as the map's cells): each such object
+//! subtends a cone of half-angle `θ = asin(R/d)` and solid angle
+//! `Ω = 2π(1 − cos θ)` seen from the light. Photon counts are shared among the cones in
+//! proportion to `Ω`; within a cone directions are uniform (`cos θ` uniform in
+//! `[cos θ_max, 1]`, the same warp as above). Cones may overlap, so a direction's
+//! density is the sum over the cones containing it, `p(ω) = Σⱼ (Nⱼ/N)/Ωⱼ`, and the
+//! photon's power is `I/(N·p(ω)) = I / Σⱼ Nⱼ/Ωⱼ`: unbiased, whatever the overlap.
+//! When the cones would cover the whole sphere (the light inside an object, an
+//! unbounded mirror plane), emission falls back to the full sphere.
+//!
+//! Points come from a Hammersley set per cone, shifted by the seed (stratified and
+//! deterministic): the same seed gives the same photons on every machine.
+
+use core::f32::consts::PI;
+
+use heapless::Vec as FixedVec;
+
+use crate::light::PointLight;
+use crate::math::{Rgb, UnitVec3, Vec3};
+use crate::sampling::hammersley;
+use crate::scene::Scene;
+
+/// The cone of directions from a light towards one object's bounding sphere.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cone {
+    axis: UnitVec3,
+    e1: UnitVec3,
+    e2: UnitVec3,
+    cos_max: f32,
+    /// `1 − cos θ_max`, computed without cancellation as `sin²θ/(1 + cos θ)`.
+    one_minus_cos: f32,
+    solid_angle: f32,
+    /// Photons aimed into this cone.
+    count: u32,
+}
+
+impl Cone {
+    #[inline]
+    fn contains(&self, d: UnitVec3) -> bool {
+        self.axis.dot(d.get()) >= self.cos_max
+    }
+}
+
+/// How one light emits its photons.
+#[derive(Clone, Debug)]
+pub(crate) enum Emission<const OBJECTS: usize> {
+    /// Uniform over the whole sphere.
+    Sphere { count: u32 },
+    /// Into the cones of the objects that can make caustics.
+    Cones(FixedVec<Cone, OBJECTS>),
+}
+
+impl<const OBJECTS: usize> Emission<OBJECTS> {
+    /// The emission plan of `light` for `count` photons. `full_sphere` forces the
+    /// paper's plain sphere (used to check the projection maps, and for direct photons).
+    pub(crate) fn plan<const LIGHTS: usize>(
+        scene: &Scene<OBJECTS, LIGHTS>,
+        light: &PointLight,
+        count: u32,
+        full_sphere: bool,
+    ) -> Self {
+        let sphere = Emission::Sphere { count };
+        if full_sphere {
+            return sphere;
+        }
+        let mut cones: FixedVec<Cone, OBJECTS> = FixedVec::new();
+        let mut total = 0.0f32;
+        for object in scene.objects().iter().filter(|o| o.material.is_specular()) {
+            let Some(bound) = object.shape.bounding_sphere() else {
+                return sphere;
+            };
+            let to = bound.center - light.position();
+            let d2 = to.length_squared();
+            let r2 = bound.radius * bound.radius;
+            let Some(axis) = UnitVec3::new(to) else {
+                return sphere;
+            };
+            if d2 <= r2 {
+                return sphere; // the light is inside the bound
+            }
+            let sin2 = r2 / d2;
+            let cos_max = libm::sqrtf(1.0 - sin2);
+            let one_minus_cos = sin2 / (1.0 + cos_max);
+            let solid_angle = 2.0 * PI * one_minus_cos;
+            let (e1, e2) = axis.basis();
+            total += solid_angle;
+            // Cannot overflow: one cone per object.
+            let _ = cones.push(Cone {
+                axis,
+                e1,
+                e2,
+                cos_max,
+                one_minus_cos,
+                solid_angle,
+                count: 0,
+            });
+        }
+        if cones.is_empty() || total >= 4.0 * PI {
+            return sphere;
+        }
+        // Share the photons in proportion to solid angle by cumulative rounding, so the
+        // counts add up to exactly `count`.
+        let mut before = 0.0f32;
+        let mut given = 0u32;
+        for c in cones.iter_mut() {
+            before += c.solid_angle;
+            let upto = if before >= total {
+                count
+            } else {
+                ((count as f32) * (before / total) + 0.5) as u32
+            };
+            let upto = upto.min(count).max(given);
+            c.count = upto - given;
+            given = upto;
+        }
+        Emission::Cones(cones)
+    }
+
+    /// Photons this plan emits.
+    pub(crate) fn count(&self) -> u32 {
+        match self {
+            Emission::Sphere { count } => *count,
+            Emission::Cones(c) => c.iter().map(|c| c.count).sum(),
+        }
+    }
+
+    /// Power of a photon of nominal weight (the largest channel of `I` over the
+    /// density of the first cone, or `4π/N` for the sphere).
+    pub(crate) fn nominal_power(&self, light: &PointLight) -> f32 {
+        let i = light.intensity().max_channel();
+        match self {
+            Emission::Sphere { count } => i * 4.0 * PI / (*count).max(1) as f32,
+            Emission::Cones(c) => {
+                let density: f32 = c
+                    .iter()
+                    .map(|c| c.count as f32 / c.solid_angle)
+                    .fold(0.0, f32::max);
+                if density > 0.0 {
+                    i / density
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// The `index`-th photon: its direction and power (W). `shift` rotates the point
+    /// set (derived from the seed and pass).
+    pub(crate) fn photon(
+        &self,
+        light: &PointLight,
+        index: u32,
+        shift: (f32, f32),
+    ) -> (UnitVec3, Rgb) {
+        match self {
+            Emission::Sphere { count } => {
+                let (s, t) = hammersley(index, *count, shift);
+                let (sin_u, cos_u) = libm::sincosf(2.0 * PI * s);
+                let sin_v = 2.0 * t - 1.0;
+                let cos_v = libm::sqrtf((1.0 - sin_v * sin_v).max(0.0));
+                let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
+                let power = light.intensity() * (4.0 * PI / *count as f32);
+                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power)
+            }
+            Emission::Cones(cones) => {
+                // Find the cone this index falls into, then its local index.
+                let mut local = index;
+                let mut which = 0;
+                for (j, c) in cones.iter().enumerate() {
+                    if local < c.count {
+                        which = j;
+                        break;
+                    }
+                    local -= c.count;
+                }
+                let c = &cones[which];
+                let (s, t) = hammersley(local, c.count, shift);
+                let om = s * c.one_minus_cos; // 1 − cos θ
+                let cos_t = 1.0 - om;
+                let sin_t = libm::sqrtf((om * (2.0 - om)).max(0.0));
+                let (sin_p, cos_p) = libm::sincosf(2.0 * PI * t);
+                let d = c.axis.get() * cos_t + (c.e1.get() * cos_p + c.e2.get() * sin_p) * sin_t;
+                let dir = UnitVec3::new(d).unwrap_or(c.axis);
+                let density: f32 = cones
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, o)| j == which || o.contains(dir))
+                    .map(|(_, o)| o.count as f32 / o.solid_angle)
+                    .sum();
+                (dir, light.intensity() * (1.0 / density))
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::geometry::Shape;
+    use crate::material::Material;
+
+    fn scene(spheres: &[(Vec3, f32)]) -> Scene<4, 1> {
+        let cam = Camera::new(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 40.0, 4, 4).unwrap();
+        let mut s = Scene::new(cam);
+        for &(c, r) in spheres {
+            s.add(
+                Shape::sphere(c, r).unwrap(),
+                Material::dielectric(1.5, Rgb::ZERO).unwrap(),
+            )
+            .unwrap();
+        }
+        s
+    }
+
+    #[test]
+    fn sphere_emission_is_uniform_per_solid_angle() {
+        let light = PointLight::new(Vec3::ZERO, Rgb::ONE).unwrap();
+        let plan: Emission<4> = Emission::Sphere { count: 40_000 };
+        // Equal-area bands in z: each must get a tenth of the photons.
+        let mut bands = [0u32; 10];
+        let mut total = Rgb::ZERO;
+        for i in 0..40_000 {
+            let (d, p) = plan.photon(&light, i, (0.1, 0.7));
+            bands[((d.get().z + 1.0) * 5.0).min(9.0) as usize] += 1;
+            total += p;
+        }
+        assert!(bands.iter().all(|&b| b.abs_diff(4000) <= 2), "{bands:?}");
+        assert!((total.r - 4.0 * PI).abs() < 1e-2);
+    }
+
+    #[test]
+    fn cones_cover_the_objects_and_carry_the_flux_they_subtend() {
+        // Two overlapping spheres: the flux emitted into the union of their cones must
+        // equal I times the union's solid angle, estimated by brute force.
+        let s = scene(&[
+            (Vec3::new(0.0, -5.0, 0.0), 1.0),
+            (Vec3::new(0.8, -5.0, 0.0), 1.0),
+        ]);
+        let light = PointLight::new(Vec3::ZERO, Rgb::ONE).unwrap();
+        let plan = Emission::plan(&s, &light, 50_000, false);
+        let Emission::Cones(cones) = &plan else {
+            panic!("expected cones")
+        };
+        assert_eq!(plan.count(), 50_000);
+        let mut flux = 0.0;
+        for i in 0..50_000 {
+            let (d, p) = plan.photon(&light, i, (0.3, 0.6));
+            assert!(cones.iter().any(|c| c.contains(d)));
+            flux += p.r;
+        }
+        let sphere: Emission<4> = Emission::Sphere { count: 400_000 };
+        let inside = (0..400_000)
+            .filter(|&i| {
+                cones
+                    .iter()
+                    .any(|c| c.contains(sphere.photon(&light, i, (0.0, 0.0)).0))
+            })
+            .count();
+        let union = 4.0 * PI * inside as f32 / 400_000.0;
+        assert!(
+            (flux - union).abs() / union < 0.01,
+            "flux {flux} vs union solid angle {union}"
+        );
+    }
+
+    #[test]
+    fn a_light_inside_an_object_uses_the_whole_sphere() {
+        let s = scene(&[(Vec3::ZERO, 2.0)]);
+        let light = PointLight::new(Vec3::new(0.5, 0.0, 0.0), Rgb::ONE).unwrap();
+        assert!(matches!(
+            Emission::plan(&s, &light, 100, false),
+            Emission::Sphere { count: 100 }
+        ));
+    }
+}

@@ -1,0 +1,436 @@
+//! The photon kd-tree: a left-balanced binary tree stored as a heap in the photon
+//! array itself (Jensen, *Realistic Image Synthesis Using Photon Mapping*, §6.3).
+//!
+//! Node `i` (0-based) has children `2i+1` and `2i+2`; each photon carries its split
+//! axis in two bits. There are no pointers and no extra memory: [`balance`] reorders
+//! the caller's slice in place in two steps.
+//!
+//! 1. **Partition.** The subtree of heap node `h` (1-based) occupies a contiguous range
+//!    of the in-order sequence, and its root sits at the in-order position
+//!    [`inorder_index`]`(h)`, which has a closed form for a left-balanced tree. So the
+//!    array is partitioned with `select_nth_unstable` around that position on the
+//!    longest axis of the range's bounding box, and the two halves are pushed on an
+//!    explicit stack (at most `log2 N + 1` deep). Cost `O(N log N)`.
+//! 2. **Permute.** The in-order layout is permuted into heap layout by following the
+//!    cycles of `h ↦ inorder_index(h)`, marking visited photons with a scratch bit.
+//!    Cost `O(N)`.
+//!
+//! Queries walk the tree with an explicit stack of at most 32 entries (a `u32` index
+//! bounds the height), nearer child first, and visit the far child only when the
+//! splitting plane is closer than the current search radius.
+
+use super::packed::{Photon, AXIS_MASK, SCRATCH};
+use crate::math::Vec3;
+
+/// The deepest tree a `u32`-indexed array can hold.
+const MAX_HEIGHT: usize = 32;
+
+/// The in-order position (0-based) of heap node `h` (1-based) in a left-balanced
+/// (complete) binary tree of `n` nodes.
+///
+/// In a perfect tree of height `H` (`2^(H−1) ≤ n < 2^H`), a node at depth `d` has
+/// in-order position `p = (2(h − 2^d) + 1)·2^(H−1−d) − 1`. The last level holds only
+/// its first `m = n − (2^(H−1) − 1)` leaves, at the even positions `0, 2, …`; the
+/// missing ones are those at `2j ≥ 2m`, so `p` moves down by `max(0, ⌈p/2⌉ − m)`.
+#[inline]
+pub fn inorder_index(h: usize, n: usize) -> usize {
+    debug_assert!(h >= 1 && h <= n);
+    let height = usize::BITS - n.leading_zeros(); // levels: 2^(H−1) ≤ n < 2^H
+    let depth = usize::BITS - 1 - h.leading_zeros();
+    let p = ((2 * (h - (1 << depth)) + 1) << (height - 1 - depth)) - 1;
+    let m = n - ((1 << (height - 1)) - 1);
+    p - (p.div_ceil(2)).saturating_sub(m)
+}
+
+/// Balances `photons` in place into a left-balanced kd-tree (heap order).
+pub fn balance(photons: &mut [Photon]) {
+    let n = photons.len();
+    if n == 0 {
+        return;
+    }
+    partition(photons);
+    permute_to_heap(photons);
+}
+
+fn partition(photons: &mut [Photon]) {
+    let n = photons.len();
+    // (heap node, lo, hi): the node's subtree occupies photons[lo..hi] in order.
+    let mut stack = [(0usize, 0usize, 0usize); MAX_HEIGHT + 1];
+    stack[0] = (1, 0, n);
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        let (h, lo, hi) = stack[sp];
+        let mid = inorder_index(h, n);
+        let range = &mut photons[lo..hi];
+        let axis = longest_axis(range);
+        if range.len() > 1 {
+            range.select_nth_unstable_by(mid - lo, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
+        }
+        photons[mid].flags = (photons[mid].flags & !AXIS_MASK) | axis as u8;
+        // Right first, so that the left subtree is processed next: the stack then holds
+        // at most one pending right subtree per level.
+        if mid + 1 < hi {
+            stack[sp] = (2 * h + 1, mid + 1, hi);
+            sp += 1;
+        }
+        if lo < mid {
+            stack[sp] = (2 * h, lo, mid);
+            sp += 1;
+        }
+    }
+}
+
+/// The axis along which the photons' bounding box is longest.
+fn longest_axis(photons: &[Photon]) -> usize {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in photons {
+        let q = p.position();
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    let e = hi - lo;
+    if e.x >= e.y && e.x >= e.z {
+        0
+    } else if e.y >= e.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// Moves the photon at in-order position `inorder_index(h)` to heap slot `h − 1`.
+fn permute_to_heap(photons: &mut [Photon]) {
+    let n = photons.len();
+    for start in 0..n {
+        if photons[start].flags & SCRATCH != 0 {
+            continue;
+        }
+        let held = photons[start];
+        let mut slot = start;
+        loop {
+            let src = inorder_index(slot + 1, n);
+            if src == start {
+                photons[slot] = held;
+                photons[slot].flags |= SCRATCH;
+                break;
+            }
+            photons[slot] = photons[src];
+            photons[slot].flags |= SCRATCH;
+            slot = src;
+        }
+    }
+    for p in photons.iter_mut() {
+        p.flags &= !SCRATCH;
+    }
+}
+
+/// One photon found by a query: its squared distance and index in the tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Neighbor {
+    /// Squared distance from the query point.
+    pub dist2: f32,
+    /// Index of the photon in the tree's array.
+    pub index: u32,
+}
+
+/// The result of a k-nearest query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Found {
+    /// How many photons were found (≤ k).
+    pub count: usize,
+    /// The squared search radius at the end: the `k`-th nearest distance when `k`
+    /// photons were found, else the maximum radius asked for.
+    pub radius2: f32,
+}
+
+/// A balanced photon array, ready for queries.
+#[derive(Clone, Copy, Debug)]
+pub struct KdTree<'a> {
+    photons: &'a [Photon],
+}
+
+impl<'a> KdTree<'a> {
+    /// Views an array already put in heap order by [`balance`].
+    pub fn from_balanced(photons: &'a [Photon]) -> Self {
+        Self { photons }
+    }
+
+    /// The photons, in heap order.
+    pub fn photons(&self) -> &'a [Photon] {
+        self.photons
+    }
+
+    /// Number of photons.
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    /// `true` when the tree holds no photon.
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    /// Calls `visit(index, dist2)` for each photon with squared distance `< radius2`
+    /// from `x`; `visit` returns the (possibly smaller) radius² to search on with.
+    #[inline]
+    pub fn search(&self, x: Vec3, mut radius2: f32, mut visit: impl FnMut(usize, f32) -> f32) {
+        let n = self.photons.len();
+        let mut stack = [(0u32, 0.0f32); MAX_HEIGHT];
+        let mut sp = 0usize;
+        let mut i = 0usize;
+        loop {
+            // Descend towards x, remembering each node and its signed plane distance.
+            while i < n {
+                let p = &self.photons[i];
+                let delta = x[p.axis()] - p.coord(p.axis());
+                stack[sp] = (i as u32, delta);
+                sp += 1;
+                i = if delta < 0.0 { 2 * i + 1 } else { 2 * i + 2 };
+            }
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            let (node, delta) = stack[sp];
+            let node = node as usize;
+            let d2 = (self.photons[node].position() - x).length_squared();
+            if d2 < radius2 {
+                radius2 = visit(node, d2);
+            }
+            // The far side can hold closer photons only if the plane is within reach.
+            i = if delta * delta < radius2 {
+                if delta < 0.0 {
+                    2 * node + 2
+                } else {
+                    2 * node + 1
+                }
+            } else {
+                n
+            };
+        }
+    }
+
+    /// The `out.len()` nearest photons to `x` closer than `sqrt(max_radius2)`, as a
+    /// max-heap on distance in `out[..count]` (the farthest first).
+    pub fn k_nearest(&self, x: Vec3, max_radius2: f32, out: &mut [Neighbor]) -> Found {
+        let k = out.len();
+        if k == 0 {
+            return Found {
+                count: 0,
+                radius2: max_radius2,
+            };
+        }
+        let mut count = 0usize;
+        self.search(x, max_radius2, |index, dist2| {
+            let nb = Neighbor {
+                dist2,
+                index: index as u32,
+            };
+            if count < k {
+                out[count] = nb;
+                count += 1;
+                sift_up(&mut out[..count], count - 1);
+                if count == k {
+                    return out[0].dist2;
+                }
+                max_radius2
+            } else {
+                // The search only offers photons closer than out[0].
+                out[0] = nb;
+                sift_down(&mut out[..k], 0);
+                out[0].dist2
+            }
+        });
+        let radius2 = if count == k {
+            out[0].dist2
+        } else {
+            max_radius2
+        };
+        Found { count, radius2 }
+    }
+}
+
+fn sift_up(heap: &mut [Neighbor], mut i: usize) {
+    while i > 0 {
+        let parent = (i - 1) / 2;
+        if heap[parent].dist2 >= heap[i].dist2 {
+            break;
+        }
+        heap.swap(parent, i);
+        i = parent;
+    }
+}
+
+fn sift_down(heap: &mut [Neighbor], mut i: usize) {
+    let n = heap.len();
+    loop {
+        let (l, r) = (2 * i + 1, 2 * i + 2);
+        let mut largest = i;
+        if l < n && heap[l].dist2 > heap[largest].dist2 {
+            largest = l;
+        }
+        if r < n && heap[r].dist2 > heap[largest].dist2 {
+            largest = r;
+        }
+        if largest == i {
+            return;
+        }
+        heap.swap(i, largest);
+        i = largest;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::vec::Vec;
+
+    use super::*;
+    use crate::math::{Rgb, UnitVec3};
+    use crate::sampling::Pcg32;
+
+    fn photon(p: Vec3, tag: u32) -> Photon {
+        // Tag photons through their power so that identity survives balancing: with the
+        // red channel in [128, 256) every channel is an exact 8-bit RGBE mantissa.
+        assert!(tag < 1 << 15);
+        Photon::new(
+            p,
+            UnitVec3::Y,
+            Rgb::new((128 + (tag & 127)) as f32, (tag >> 7) as f32, 0.0),
+        )
+    }
+
+    fn tag(p: &Photon) -> u32 {
+        let c = p.power();
+        (c.r as u32 - 128) | ((c.g as u32) << 7)
+    }
+
+    fn random_set(n: usize, seed: u64) -> Vec<Photon> {
+        let mut g = Pcg32::new(seed);
+        (0..n)
+            .map(|i| {
+                photon(
+                    Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 10.0,
+                    i as u32,
+                )
+            })
+            .collect()
+    }
+
+    fn assert_heap_property(photons: &[Photon]) {
+        // Every node splits its subtree: left descendants ≤, right descendants ≥.
+        let n = photons.len();
+        for i in 0..n {
+            let axis = photons[i].axis();
+            let split = photons[i].coord(axis);
+            let mut stack = std::vec![(2 * i + 1, true), (2 * i + 2, false)];
+            while let Some((j, left)) = stack.pop() {
+                if j >= n {
+                    continue;
+                }
+                let c = photons[j].coord(axis);
+                assert!(
+                    if left { c <= split } else { c >= split },
+                    "node {i} child {j}"
+                );
+                stack.push((2 * j + 1, left));
+                stack.push((2 * j + 2, left));
+            }
+        }
+    }
+
+    fn brute_k_nearest(photons: &[Photon], x: Vec3, r2: f32, k: usize) -> Vec<f32> {
+        let mut d: Vec<f32> = photons
+            .iter()
+            .map(|p| (p.position() - x).length_squared())
+            .filter(|&d| d < r2)
+            .collect();
+        d.sort_by(f32::total_cmp);
+        d.truncate(k);
+        d
+    }
+
+    fn check_queries(photons: &[Photon], seed: u64) {
+        let mut tree_photons = photons.to_vec();
+        balance(&mut tree_photons);
+        // Nothing lost, nothing duplicated.
+        let mut before: Vec<u32> = photons.iter().map(tag).collect();
+        let mut after: Vec<u32> = tree_photons.iter().map(tag).collect();
+        before.sort_unstable();
+        after.sort_unstable();
+        assert_eq!(before, after);
+        assert_heap_property(&tree_photons);
+        let tree = KdTree::from_balanced(&tree_photons);
+        let mut g = Pcg32::new(seed);
+        for q in 0..60 {
+            let x = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 12.0 - Vec3::ONE;
+            let k = [1, 2, 7, 32][q % 4];
+            let r2 = [0.5f32, 4.0, 1e9][q % 3];
+            let mut out = std::vec![Neighbor::default(); k];
+            let found = tree.k_nearest(x, r2, &mut out);
+            let mut got: Vec<f32> = out[..found.count].iter().map(|n| n.dist2).collect();
+            got.sort_by(f32::total_cmp);
+            let want = brute_k_nearest(photons, x, r2, k);
+            assert_eq!(got, want, "query {q} k={k} r2={r2}");
+            // Each reported distance belongs to the photon it names.
+            for nb in &out[..found.count] {
+                assert_eq!(
+                    (tree_photons[nb.index as usize].position() - x).length_squared(),
+                    nb.dist2
+                );
+            }
+            // A radius query sees exactly the brute-force set.
+            let mut inside = 0;
+            tree.search(x, r2, |_, _| {
+                inside += 1;
+                r2
+            });
+            assert_eq!(inside, brute_k_nearest(photons, x, r2, usize::MAX).len());
+        }
+    }
+
+    #[test]
+    fn inorder_index_matches_an_explicit_traversal() {
+        for n in 1..200usize {
+            let mut order = Vec::new();
+            let mut stack = Vec::new();
+            let mut h = 1;
+            loop {
+                while h <= n {
+                    stack.push(h);
+                    h *= 2;
+                }
+                let Some(top) = stack.pop() else { break };
+                order.push(top);
+                h = 2 * top + 1;
+            }
+            for (pos, &node) in order.iter().enumerate() {
+                assert_eq!(inorder_index(node, n), pos, "n={n} h={node}");
+            }
+        }
+    }
+
+    #[test]
+    fn random_sets_of_many_sizes_agree_with_brute_force() {
+        for n in [0usize, 1, 2, 3, 5, 17, 64, 100, 255, 256, 1000, 4097] {
+            check_queries(&random_set(n, n as u64), 99 + n as u64);
+        }
+    }
+
+    #[test]
+    fn degenerate_sets_agree_with_brute_force() {
+        // All photons on a plane, on a line, and all at one point (duplicates).
+        let mut g = Pcg32::new(5);
+        let plane: Vec<Photon> = (0..500)
+            .map(|i| photon(Vec3::new(g.next_f32() * 10.0, 0.0, g.next_f32() * 10.0), i))
+            .collect();
+        check_queries(&plane, 1);
+        let line: Vec<Photon> = (0..300)
+            .map(|i| photon(Vec3::new(1.0, 2.0, (i % 37) as f32 * 0.25), i))
+            .collect();
+        check_queries(&line, 2);
+        let point: Vec<Photon> = (0..129).map(|i| photon(Vec3::splat(3.0), i)).collect();
+        check_queries(&point, 3);
+    }
+}

@@ -1,0 +1,263 @@
+//! The backward pass: Whitted ray tracing from the eye, with the caustic store's
+//! estimate added at every diffuse hit; pixels leave row by row.
+//!
+//! At a hit, by material:
+//! - **diffuse** (front side only): direct light `ρ/π · I·cosθ/d²` from each unoccluded
+//!   point light (every object blocks a shadow ray), plus `ρ/π · E_caustic`;
+//! - **mirror** (both sides): the reflected ray, weighted by the reflectance;
+//! - **dielectric**: reflection weighted by Fresnel `F` and refraction by
+//!   `(1 − F)·(η_i/η_t)²` (radiance is scaled by the squared ratio of indices across an
+//!   interface, pbrt-v4 §9.5.2); Beer attenuation `exp(−σ t)` inside;
+//! - **classic** (paper): `k_a·color·ambient + Σ_lights vis·(I/d²)·kernel + eq. 8 +
+//!   reflectivity·L_reflected + transparency·L_refracted`, where `kernel` is eq. 8's
+//!   summand with the light as its single photon.
+//!
+//! A path takes at most `max_depth` specular interactions; one that meets a further
+//! specular surface contributes nothing. The tree of reflected and refracted branches
+//! is walked depth-first with an explicit stack of `DEPTH` entries: each pending entry
+//! has a different depth, so `DEPTH ≥ max_depth` always suffices and nothing recurses.
+
+use heapless::Vec as FixedVec;
+
+use crate::error::Error;
+use crate::geometry::{Hit, Ray};
+use crate::material::{interface, Classic, Material};
+use crate::math::{reflect, Rgb, UnitVec3};
+use crate::photon::CausticStore;
+use crate::scene::Scene;
+
+/// Rays traced, for statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCount {
+    /// Camera rays and their reflected/refracted descendants.
+    pub eye: u64,
+    /// Shadow rays towards lights.
+    pub shadow: u64,
+}
+
+impl core::ops::AddAssign for RayCount {
+    fn add_assign(&mut self, o: Self) {
+        self.eye += o.eye;
+        self.shadow += o.shadow;
+    }
+}
+
+/// One pending branch of an eye path.
+#[derive(Clone, Copy, Debug)]
+struct Branch {
+    ray: Ray,
+    weight: Rgb,
+    depth: u32,
+}
+
+/// Renders a scene against a caustic store, with a path stack of `DEPTH` entries.
+#[derive(Debug)]
+pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPTH: usize> {
+    scene: &'a Scene<OBJECTS, LIGHTS>,
+    store: &'a S,
+    max_depth: u32,
+}
+
+impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
+    Renderer<'a, S, O, L, DEPTH>
+{
+    /// A renderer; an error when `max_depth` exceeds the compiled stack `DEPTH`.
+    pub fn new(scene: &'a Scene<O, L>, store: &'a S, max_depth: u32) -> Result<Self, Error> {
+        if max_depth as usize > DEPTH {
+            return Err(Error::Capacity {
+                what: "photons.max_depth",
+                requested: max_depth as usize,
+                capacity: DEPTH,
+            });
+        }
+        Ok(Self {
+            scene,
+            store,
+            max_depth,
+        })
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene<O, L> {
+        self.scene
+    }
+
+    /// Radiance arriving at the origin of `ray` along it.
+    pub fn radiance(&self, ray: Ray, count: &mut RayCount) -> Rgb {
+        let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
+        let mut total = Rgb::ZERO;
+        let mut next = Some(Branch {
+            ray,
+            weight: Rgb::ONE,
+            depth: 0,
+        });
+        while let Some(b) = next.take().or_else(|| stack.pop()) {
+            count.eye += 1;
+            let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
+                total += b.weight * self.scene.background();
+                continue;
+            };
+            let material = &self.scene.objects()[index].material;
+            let (local, first, second) = self.scatter(&b, &hit, material, count);
+            total += local;
+            // Continue with one branch, keep the other for later (a different depth
+            // from every branch already waiting, so the stack never overflows).
+            next = first;
+            if let Some(s) = second {
+                if stack.push(s).is_err() {
+                    debug_assert!(false, "path stack overflow: DEPTH < max_depth");
+                }
+            }
+        }
+        total
+    }
+
+    /// Light leaving `hit` towards the eye directly, and up to two specular branches.
+    #[inline]
+    fn scatter(
+        &self,
+        b: &Branch,
+        hit: &Hit,
+        material: &Material,
+        count: &mut RayCount,
+    ) -> (Rgb, Option<Branch>, Option<Branch>) {
+        let d = b.ray.dir;
+        let front = hit.front_face(d);
+        let facing = if front { hit.normal } else { -hit.normal };
+        let can_bounce = b.depth < self.max_depth;
+        let branch = |dir: UnitVec3, w: Rgb| {
+            (!w.is_black()).then(|| Branch {
+                ray: Ray::spawn(hit, dir),
+                weight: w,
+                depth: b.depth + 1,
+            })
+        };
+        match material {
+            Material::Diffuse(m) => {
+                if !front {
+                    return (Rgb::ZERO, None, None);
+                }
+                let mut e = self.store.irradiance(hit.point, hit.normal);
+                for light in self.scene.lights() {
+                    if let Some((l, irradiance)) = self.direct_one(hit, light, count) {
+                        e += irradiance * hit.normal.dot(l.get());
+                    }
+                }
+                (
+                    b.weight * m.albedo * e * core::f32::consts::FRAC_1_PI,
+                    None,
+                    None,
+                )
+            }
+            Material::Mirror(m) if can_bounce => (
+                Rgb::ZERO,
+                branch(reflect(d, facing), b.weight * m.reflectance),
+                None,
+            ),
+            Material::Dielectric(g) if can_bounce => {
+                let weight = if front {
+                    b.weight
+                } else {
+                    b.weight * g.absorption.beer(hit.t)
+                };
+                let eta = if front { 1.0 / g.ior } else { g.ior };
+                let i = interface(d, facing, eta);
+                let reflected = branch(reflect(d, facing), weight * i.reflectance);
+                let refracted = i
+                    .refracted
+                    .and_then(|t| branch(t, weight * ((1.0 - i.reflectance) * eta * eta)));
+                (Rgb::ZERO, reflected, refracted)
+            }
+            Material::Classic(c) => {
+                let local = if front {
+                    self.classic_local(hit, c, -d, count)
+                } else {
+                    Rgb::ZERO
+                };
+                if !can_bounce {
+                    return (b.weight * local, None, None);
+                }
+                let eta = if front { 1.0 / c.ior } else { c.ior };
+                let r = reflect(d, facing);
+                let reflected = branch(r, b.weight * c.reflectivity);
+                let t = interface(d, facing, eta).refracted.unwrap_or(r);
+                let refracted = branch(t, b.weight * c.transparency);
+                (b.weight * local, reflected, refracted)
+            }
+            // A specular surface after max_depth interactions contributes nothing.
+            Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, None, None),
+        }
+    }
+
+    /// The classic model's local part at a front-side hit seen from `to_eye`.
+    fn classic_local(&self, hit: &Hit, c: &Classic, to_eye: UnitVec3, count: &mut RayCount) -> Rgb {
+        let n = hit.normal;
+        let ambient = c.color * self.scene.ambient() * c.ambient;
+        let mut lit = Rgb::ZERO;
+        for light in self.scene.lights() {
+            if let Some((l, e)) = self.direct_one(hit, light, count) {
+                lit += c.kernel(n, l, to_eye) * e;
+            }
+        }
+        ambient + lit + self.store.classic(hit.point, n, to_eye, c)
+    }
+
+    /// Direction `l` and normal-incidence irradiance `I/d²` of one light if it shines
+    /// on the front of `hit` (`n·l > 0`) unoccluded: one shadow ray, which every object
+    /// blocks. Dark lights cost nothing.
+    #[inline]
+    fn direct_one(
+        &self,
+        hit: &Hit,
+        light: &crate::light::PointLight,
+        count: &mut RayCount,
+    ) -> Option<(UnitVec3, Rgb)> {
+        if light.intensity().is_black() {
+            return None;
+        }
+        let to = light.position() - hit.point;
+        let d2 = to.length_squared();
+        let l = UnitVec3::new(to)?;
+        if !(hit.normal.dot(l.get()) > 0.0) {
+            return None;
+        }
+        let shadow = Ray::spawn(hit, l);
+        count.shadow += 1;
+        if self
+            .scene
+            .occluded(&shadow, (light.position() - shadow.origin).length())
+        {
+            return None;
+        }
+        Some((l, light.intensity() * (1.0 / d2)))
+    }
+
+    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width).
+    pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
+        let mut count = RayCount::default();
+        let camera = self.scene.camera();
+        for (x, px) in row.iter_mut().enumerate() {
+            *px = self.radiance(camera.ray(x as u32, y), &mut count);
+        }
+        count
+    }
+
+    /// Renders every row, top to bottom, into the caller's one-row buffer and hands each
+    /// to `sink` before the next is computed: no frame buffer. Stops at the sink's
+    /// first error and returns it.
+    pub fn rows<E>(
+        &self,
+        row: &mut [Rgb],
+        mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
+    ) -> Result<RayCount, E> {
+        let mut count = RayCount::default();
+        let width = self.scene.camera().width() as usize;
+        let width = width.min(row.len());
+        let row = &mut row[..width];
+        for y in 0..self.scene.camera().height() {
+            count += self.row(y, row);
+            sink(y, row)?;
+        }
+        Ok(count)
+    }
+}

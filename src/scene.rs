@@ -1,0 +1,172 @@
+//! The scene: camera, objects, lights, in fixed-capacity storage.
+
+use heapless::Vec as FixedVec;
+
+use crate::camera::Camera;
+use crate::error::Error;
+use crate::geometry::{Hit, Ray, Shape};
+use crate::light::PointLight;
+use crate::material::Material;
+use crate::math::Rgb;
+
+/// A shape with its material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Object {
+    /// The geometry.
+    pub shape: Shape,
+    /// How it scatters light.
+    pub material: Material,
+}
+
+/// A scene holding at most `OBJECTS` objects and `LIGHTS` point lights; both
+/// capacities are compiled in, so `size_of::<Scene<O, L>>()` is its whole memory.
+#[derive(Clone, Debug)]
+pub struct Scene<const OBJECTS: usize, const LIGHTS: usize> {
+    camera: Camera,
+    objects: FixedVec<Object, OBJECTS>,
+    lights: FixedVec<PointLight, LIGHTS>,
+    background: Rgb,
+    ambient: Rgb,
+}
+
+impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
+    /// An empty scene seen by `camera`, with a black background and no ambient light.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            objects: FixedVec::new(),
+            lights: FixedVec::new(),
+            background: Rgb::ZERO,
+            ambient: Rgb::ZERO,
+        }
+    }
+
+    /// Adds an object; an error when the compiled capacity is full.
+    pub fn add(&mut self, shape: Shape, material: Material) -> Result<(), Error> {
+        self.objects
+            .push(Object { shape, material })
+            .map_err(|_| Error::Capacity {
+                what: "objects",
+                requested: OBJECTS + 1,
+                capacity: OBJECTS,
+            })
+    }
+
+    /// Adds a light; an error when the compiled capacity is full.
+    pub fn add_light(&mut self, light: PointLight) -> Result<(), Error> {
+        self.lights.push(light).map_err(|_| Error::Capacity {
+            what: "lights",
+            requested: LIGHTS + 1,
+            capacity: LIGHTS,
+        })
+    }
+
+    /// Radiance of rays that leave the scene (validated: finite, ≥ 0).
+    pub fn set_background(&mut self, background: Rgb) -> Result<(), Error> {
+        self.background = background.validate("background")?;
+        Ok(())
+    }
+
+    /// Ambient light for the `classic` model (validated: finite, ≥ 0).
+    pub fn set_ambient(&mut self, ambient: Rgb) -> Result<(), Error> {
+        self.ambient = ambient.validate("ambient")?;
+        Ok(())
+    }
+
+    /// Replaces the camera (for example to change the image size).
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The objects.
+    pub fn objects(&self) -> &[Object] {
+        &self.objects
+    }
+
+    /// The lights.
+    pub fn lights(&self) -> &[PointLight] {
+        &self.lights
+    }
+
+    /// Background radiance.
+    pub fn background(&self) -> Rgb {
+        self.background
+    }
+
+    /// Ambient light of the classic model.
+    pub fn ambient(&self) -> Rgb {
+        self.ambient
+    }
+
+    /// `true` when some object can focus light into a caustic; without one the
+    /// forward pass is skipped altogether.
+    pub fn has_caustic_objects(&self) -> bool {
+        self.objects.iter().any(|o| o.material.is_specular())
+    }
+
+    /// The nearest hit along `ray` with `t < t_max`, and the index of the object hit.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(Hit, usize)> {
+        let mut best: Option<(Hit, usize)> = None;
+        let mut limit = t_max;
+        for (i, o) in self.objects.iter().enumerate() {
+            if let Some(h) = o.shape.intersect(ray, limit) {
+                limit = h.t;
+                best = Some((h, i));
+            }
+        }
+        best
+    }
+
+    /// `true` when anything lies along `ray` before `t_max`: the shadow-ray query.
+    /// Every object blocks, glass and mirrors included (light through them arrives
+    /// only as caustics).
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.objects
+            .iter()
+            .any(|o| o.shape.intersect(ray, t_max).is_some())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{UnitVec3, Vec3};
+
+    #[test]
+    fn capacity_is_an_error_not_a_truncation() {
+        let cam = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 4, 4).unwrap();
+        let mut s: Scene<1, 1> = Scene::new(cam);
+        let m = Material::diffuse(Rgb::ONE).unwrap();
+        s.add(Shape::sphere(Vec3::ZERO, 1.0).unwrap(), m).unwrap();
+        assert_eq!(
+            s.add(Shape::sphere(Vec3::ZERO, 1.0).unwrap(), m),
+            Err(Error::Capacity {
+                what: "objects",
+                requested: 2,
+                capacity: 1
+            })
+        );
+    }
+
+    #[test]
+    fn nearest_hit_wins() {
+        let cam = Camera::new(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 4, 4).unwrap();
+        let mut s: Scene<2, 1> = Scene::new(cam);
+        let m = Material::diffuse(Rgb::ONE).unwrap();
+        s.add(Shape::sphere(Vec3::new(0.0, 0.0, 10.0), 1.0).unwrap(), m)
+            .unwrap();
+        s.add(Shape::sphere(Vec3::new(0.0, 0.0, 5.0), 1.0).unwrap(), m)
+            .unwrap();
+        let r = Ray::new(Vec3::ZERO, UnitVec3::Z);
+        let (h, i) = s.intersect(&r, f32::INFINITY).unwrap();
+        assert_eq!((h.t, i), (4.0, 1));
+        assert!(s.occluded(&r, 4.5) && !s.occluded(&r, 3.5));
+    }
+}
