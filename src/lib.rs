@@ -55,6 +55,7 @@
 extern crate std;
 
 pub mod camera;
+pub mod demo;
 mod error;
 pub mod geometry;
 pub mod light;
