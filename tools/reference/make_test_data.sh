@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # Regenerates the committed reference images tests/data/<scene>.ref.pfm (+ .ref.caustic.pfm)
 # at 160x120 (seed 1), renders a second seed into $OUT, and prints the self-checks and the
-# seed-to-seed noise for each scene. Usage: tools/reference/make_test_data.sh [PHOTONS]
+# seed-to-seed noise for each scene.
+# Usage: [SCENES="glass_sphere two_balls tube"] tools/reference/make_test_data.sh [PHOTONS]
 set -euo pipefail
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 REPO="$(cd "$HERE/../.." && pwd)"
 PHOTONS="${1:-100000000}"
 OUT="${OUT:-${TMPDIR:-/tmp}/caustic-reference}"
 mkdir -p "$REPO/tests/data" "$OUT"
-for s in glass_sphere two_balls tube; do
+for s in ${SCENES:-glass_sphere two_balls tube}; do
   for seed in 1 2; do
     pre="$OUT/$s.s$seed"
     start=$(date +%s)
