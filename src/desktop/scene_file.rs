@@ -59,9 +59,8 @@ fn core_err(base: &str, e: Error, fields: &[&str]) -> SceneError {
         | Error::Degenerate { what }
         | Error::Capacity { what, .. } => what,
     };
-    let field = fields
-        .iter()
-        .find(|f| what.ends_with(*f) || what.starts_with(*f));
+    // The first field (in the caller's order of preference) that the message names.
+    let field = fields.iter().find(|f| what.contains(*f));
     let path = match field {
         Some(f) if base.is_empty() => f.to_string(),
         Some(f) => format!("{base}.{f}"),
@@ -295,7 +294,7 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             } => "image",
             _ => "camera",
         };
-        core_err(path, e, &["position", "look_at", "up", "fov_y_deg"])
+        core_err(path, e, &["look_at", "position", "up", "fov_y_deg"])
     })?;
     let mut scene = DesktopScene::new(camera);
     if let Some(b) = doc.background {

@@ -1,0 +1,515 @@
+//! The backward pass end to end: analytic radiance, refraction geometry, determinism
+//! across threads, and the scene files' error messages.
+
+use caustic::camera::Camera;
+use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
+use caustic::geometry::{Ray, Shape};
+use caustic::light::PointLight;
+use caustic::material::{interface, Material};
+use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
+use caustic::photon::{NoCaustics, PhotonSettings};
+use caustic::render::{RayCount, Renderer};
+use caustic::scene::Scene;
+
+fn read(name: &str) -> String {
+    std::fs::read_to_string(format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// A diffuse floor of albedo ρ under a point light: every pixel that sees the floor has
+/// radiance ρ·I·cosθ/(π·d²), evaluated here in f64 from the analytic ray–plane hit.
+#[test]
+fn direct_light_on_a_diffuse_floor_is_analytic() {
+    let (albedo, intensity, light) = (0.63f32, Rgb::new(10.0, 5.0, 2.5), Vec3::new(0.4, 2.5, -0.3));
+    let camera = Camera::new(
+        Vec3::new(0.0, 3.0, 4.0),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::Y,
+        50.0,
+        48,
+        36,
+    )
+    .unwrap();
+    let mut scene: Scene<1, 1> = Scene::new(camera);
+    scene
+        .add(
+            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
+            Material::diffuse(Rgb::splat(albedo)).unwrap(),
+        )
+        .unwrap();
+    scene
+        .add_light(PointLight::new(light, intensity).unwrap())
+        .unwrap();
+    let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
+    let mut worst = 0.0f64;
+    let mut seen = 0;
+    for y in 0..36 {
+        for x in 0..48 {
+            let ray = camera.ray(x, y);
+            let got = r.radiance(ray, &mut RayCount::default());
+            let (o, d) = (ray.origin.as_dvec3(), ray.dir.get().as_dvec3());
+            if d.y >= 0.0 {
+                assert_eq!(got, Rgb::ZERO);
+                continue;
+            }
+            let p = o + d * (-o.y / d.y);
+            let to = light.as_dvec3() - p;
+            let cos = to.y / to.length();
+            for (c, i) in got.to_array().into_iter().zip(intensity.to_array()) {
+                let want =
+                    albedo as f64 * i as f64 * cos / (std::f64::consts::PI * to.length_squared());
+                worst = worst.max((c as f64 - want).abs() / want);
+            }
+            seen += 1;
+        }
+    }
+    assert!(seen > 500);
+    assert!(worst < 1e-3, "worst relative error {worst}");
+}
+
+/// A ray through a parallel glass slab leaves parallel to how it came in, displaced.
+#[test]
+fn refraction_through_a_slab_exits_parallel() {
+    let slab = Shape::cuboid(
+        Vec3::ZERO,
+        Vec3::new(100.0, 0.5, 100.0),
+        Vec3::new(0.0, 0.0, 0.0),
+    )
+    .unwrap();
+    for (i, angle) in [0.0f32, 0.2, 0.5, 0.9, 1.3].into_iter().enumerate() {
+        let d = UnitVec3::new(Vec3::new(angle.sin(), -angle.cos(), 0.1 * i as f32)).unwrap();
+        let ray = Ray::new(Vec3::new(0.0, 2.0, 0.0), d);
+        let h = slab.intersect(&ray, f32::INFINITY).unwrap();
+        let inside = interface(d, h.normal, 1.0 / 1.5).refracted.unwrap();
+        let r2 = Ray::spawn(&h, inside);
+        let h2 = slab.intersect(&r2, f32::INFINITY).unwrap();
+        assert!(
+            h2.normal.dot(inside.get()) > 0.0,
+            "must leave through the far face"
+        );
+        let out = interface(inside, -h2.normal, 1.5).refracted.unwrap();
+        assert!(
+            (out.get() - d.get()).length() < 1e-5,
+            "angle {angle}: {out:?} vs {d:?}"
+        );
+        if angle > 0.0 {
+            assert!(
+                (h2.point - h.point).normalize().dot(d.get()) < 0.9999,
+                "the path bends inside"
+            );
+        }
+    }
+    // Mirror reflection of a reflection is the identity.
+    let d = UnitVec3::new(Vec3::new(0.3, -0.8, 0.1)).unwrap();
+    let n = UnitVec3::new(Vec3::new(0.1, 1.0, 0.2)).unwrap();
+    assert!((reflect(reflect(d, n), n).get() - d.get()).length() < 1e-6);
+}
+
+/// Glass and mirrors block direct light: under a glass sphere the floor gets no direct
+/// light, only what the caustic store adds.
+#[test]
+fn glass_casts_a_shadow_for_direct_light() {
+    let camera = Camera::new(Vec3::new(0.0, 5.0, 0.001), Vec3::ZERO, Vec3::Y, 10.0, 9, 9).unwrap();
+    let mut scene: Scene<2, 1> = Scene::new(camera);
+    scene
+        .add(
+            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
+            Material::diffuse(Rgb::ONE).unwrap(),
+        )
+        .unwrap();
+    scene
+        .add(
+            Shape::sphere(Vec3::new(5.0, 2.0, 0.0), 0.5).unwrap(),
+            Material::dielectric(1.5, Rgb::ZERO).unwrap(),
+        )
+        .unwrap();
+    scene
+        .add_light(PointLight::new(Vec3::new(10.0, 4.0, 0.0), Rgb::ONE).unwrap())
+        .unwrap();
+    let r: Renderer<_, 2, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
+    // The floor point (0,0,0) lies exactly behind the sphere as seen from the light.
+    let down = Ray::new(Vec3::new(0.0, 1.0, 0.0), -UnitVec3::Y);
+    assert_eq!(r.radiance(down, &mut RayCount::default()), Rgb::ZERO);
+    let beside = Ray::new(Vec3::new(0.0, 1.0, 3.0), -UnitVec3::Y);
+    assert!(r.radiance(beside, &mut RayCount::default()).r > 0.0);
+}
+
+/// `max_depth` bounds specular interactions: between two parallel mirrors an eye ray
+/// bounces exactly `max_depth` times and then contributes nothing (not the background).
+#[test]
+fn max_depth_ends_paths_at_a_further_specular_surface() {
+    let camera = Camera::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 10.0, 1, 1).unwrap();
+    let mut scene: Scene<2, 1> = Scene::new(camera);
+    let mirror = Material::mirror(Rgb::splat(0.5)).unwrap();
+    scene
+        .add(
+            Shape::plane(Vec3::new(0.0, 0.0, -1.0), Vec3::Z).unwrap(),
+            mirror,
+        )
+        .unwrap();
+    scene
+        .add(
+            Shape::plane(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z).unwrap(),
+            mirror,
+        )
+        .unwrap();
+    scene.set_background(Rgb::ONE).unwrap();
+    for depth in [0u32, 1, 3, 7] {
+        let r: Renderer<_, 2, 1, 8> = Renderer::new(&scene, &NoCaustics, depth).unwrap();
+        let mut count = RayCount::default();
+        let l = r.radiance(camera.ray(0, 0), &mut count);
+        assert_eq!(l, Rgb::ZERO);
+        assert_eq!(count.eye, depth as u64 + 1, "depth {depth}");
+    }
+    assert!(
+        Renderer::<_, 2, 1, 8>::new(&scene, &NoCaustics, 9).is_err(),
+        "max_depth beyond the stack"
+    );
+}
+
+fn small(name: &str, w: u32, h: u32) -> (DesktopScene, PhotonSettings) {
+    let loaded = parse_scene(&read(name)).unwrap();
+    let mut scene = loaded.scene;
+    scene.set_camera(scene.camera().with_size(w, h).unwrap());
+    let p = loaded.photons;
+    (
+        scene,
+        PhotonSettings::new(20_000, p.k(), p.max_radius(), p.max_depth()).unwrap(),
+    )
+}
+
+fn bits(img: &caustic::desktop::Image) -> Vec<[u32; 3]> {
+    img.pixels
+        .iter()
+        .map(|p| p.to_array().map(f32::to_bits))
+        .collect()
+}
+
+/// Threads only change the order rows are computed in: the image is bit-identical.
+#[test]
+fn images_are_bit_identical_whatever_the_thread_count() {
+    for name in ["two_balls.json", "fig6.json"] {
+        let (scene, settings) = small(name, 64, 48);
+        let one = RenderOptions {
+            threads: 1,
+            seed: 3,
+            ..RenderOptions::default()
+        };
+        let (a, sa) = render(&scene, &settings, &one).unwrap();
+        let (b, sb) = render(&scene, &settings, &RenderOptions { threads: 5, ..one }).unwrap();
+        assert_eq!(bits(&a), bits(&b), "{name}");
+        assert_eq!((sa.rays, sa.photons_stored), (sb.rays, sb.photons_stored));
+        assert!(sa.photons_stored > 0 && a.pixels.iter().all(|p| p.is_finite()));
+        // Another seed gives other photons, and so another image.
+        let (c, _) = render(&scene, &settings, &RenderOptions { seed: 4, ..one }).unwrap();
+        assert_ne!(bits(&a), bits(&c), "{name}");
+    }
+}
+
+/// The Fig. 6 scene the device builds in code is the scene in `scenes/fig6.json`.
+#[test]
+fn the_device_scene_is_the_scene_file() {
+    let file = parse_scene(&read("fig6.json")).unwrap().scene;
+    let code: DesktopScene = caustic::demo::fig6(320, 240).unwrap();
+    assert_eq!(file.objects(), code.objects());
+    assert_eq!(file.lights(), code.lights());
+    assert_eq!(file.camera(), code.camera());
+    assert_eq!(
+        (file.background(), file.ambient()),
+        (code.background(), code.ambient())
+    );
+}
+
+/// Every scene in `scenes/` parses.
+#[test]
+fn example_scenes_parse() {
+    for entry in std::fs::read_dir(format!("{}/scenes", env!("CARGO_MANIFEST_DIR"))).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "json") {
+            parse_scene(&std::fs::read_to_string(&path).unwrap())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        }
+    }
+}
+
+/// Applies `edit` to the glass-sphere scene's JSON and returns the parse error.
+fn error_after(edit: impl FnOnce(&mut serde_json::Value)) -> caustic::desktop::SceneError {
+    let mut v: serde_json::Value = serde_json::from_str(&read("glass_sphere.json")).unwrap();
+    edit(&mut v);
+    parse_scene(&v.to_string()).expect_err("must be rejected")
+}
+
+#[test]
+fn every_scene_error_names_its_path_and_problem() {
+    use serde_json::json;
+    type Edit = Box<dyn FnOnce(&mut serde_json::Value)>;
+    let cases: Vec<(Edit, &str, &str)> = vec![
+        (
+            Box::new(|v| v["camra"] = json!(1)),
+            "camra",
+            "unknown field `camra`",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["radius"] = json!(0)),
+            "objects[1].radius",
+            "must be positive",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["radius"] = json!(-2.5)),
+            "objects[1].radius",
+            "must be positive",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["radius"] = json!("big")),
+            "objects[1].radius",
+            "invalid type",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["radius"] = json!(1e300)),
+            "objects[1].radius",
+            "finite",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["radus"] = json!(1)),
+            "objects[1].radus",
+            "unknown field `radus`",
+        ),
+        (
+            Box::new(|v| {
+                v["objects"][1].as_object_mut().unwrap().remove("radius");
+            }),
+            "objects[1]",
+            "missing field `radius`",
+        ),
+        (
+            Box::new(|v| v["objects"][0]["type"] = json!("torus")),
+            "objects[0].type",
+            "unknown type \"torus\"",
+        ),
+        (
+            Box::new(|v| v["objects"][0]["normal"] = json!([0, 0, 0])),
+            "objects[0].normal",
+            "degenerate",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["material"] = json!("glas")),
+            "objects[1].material",
+            "unknown material \"glas\"",
+        ),
+        (
+            Box::new(|v| v["objects"][1]["center"] = json!([0, 1])),
+            "objects[1].center",
+            "invalid length 2",
+        ),
+        (
+            Box::new(|v| {
+                v["objects"][1] = json!({"type": "box", "center": [0,0,0], "size": [1, 0, 1], "material": "glass"})
+            }),
+            "objects[1].size",
+            "must be positive",
+        ),
+        (
+            Box::new(
+                |v| v["objects"][1] = json!({"type": "cylinder", "base": [0,0,0], "axis": [0,0,0], "radius": 1, "height": 1, "material": "glass"}),
+            ),
+            "objects[1].axis",
+            "degenerate",
+        ),
+        (
+            Box::new(|v| v["materials"]["glass"]["ior"] = json!(-1)),
+            "materials.glass.ior",
+            "must be positive",
+        ),
+        (
+            Box::new(|v| v["materials"]["floor"]["albedo"] = json!([1.5, 0, 0])),
+            "materials.floor.albedo",
+            "[0, 1]",
+        ),
+        (
+            Box::new(|v| v["materials"]["floor"]["type"] = json!("lambert")),
+            "materials.floor.type",
+            "unknown type",
+        ),
+        (
+            Box::new(|v| {
+                v["materials"]["c"] = json!({"type": "classic", "color": [1,1,1], "ambient": 0.1, "diffuse": 0.5,
+                "specular": 0.1, "shininess": 5, "reflectivity": 0.6, "transparency": 0.6, "ior": 1.2})
+            }),
+            "materials.c.reflectivity",
+            "reflectivity + transparency",
+        ),
+        (
+            Box::new(|v| v["lights"][0]["intensity"] = json!([-1, 0, 0])),
+            "lights[0].intensity",
+            "[0,",
+        ),
+        (
+            Box::new(|v| v["lights"][0]["type"] = json!("spot")),
+            "lights[0].type",
+            "unknown type \"spot\"",
+        ),
+        (
+            Box::new(|v| v["camera"]["look_at"] = json!([0, 4, 7])),
+            "camera.look_at",
+            "degenerate",
+        ),
+        (
+            Box::new(|v| v["camera"]["fov_y_deg"] = json!(180)),
+            "camera.fov_y_deg",
+            "[0.001, 179]",
+        ),
+        (
+            Box::new(|v| v["camera"]["up"] = json!([0, 0, 0])),
+            "camera.up",
+            "degenerate",
+        ),
+        (
+            Box::new(|v| v["image"]["width"] = json!(0)),
+            "image",
+            "image width",
+        ),
+        (
+            Box::new(|v| v["image"]["height"] = json!(-3)),
+            "image.height",
+            "invalid value",
+        ),
+        (
+            Box::new(|v| v["photons"]["k"] = json!(0)),
+            "photons.k",
+            "must be positive",
+        ),
+        (
+            Box::new(|v| v["photons"]["k"] = json!(100_000)),
+            "photons.k",
+            "gather capacity",
+        ),
+        (
+            Box::new(|v| v["photons"]["max_radius"] = json!(0)),
+            "photons.max_radius",
+            "must be positive",
+        ),
+        (
+            Box::new(|v| v["photons"]["max_depth"] = json!(40)),
+            "photons.max_depth",
+            "path stack capacity",
+        ),
+        (
+            Box::new(|v| v["photons"]["max_depth"] = json!(1000)),
+            "photons.max_depth",
+            "[0, 255]",
+        ),
+        (
+            Box::new(|v| v["photons"]["passes"] = json!(0)),
+            "photons.passes",
+            "at least 1",
+        ),
+        (
+            Box::new(|v| v["photons"]["alpha"] = json!(1.5)),
+            "photons.alpha",
+            "(0, 1)",
+        ),
+        (
+            Box::new(|v| v["photons"]["count"] = json!(-5)),
+            "photons.count",
+            "invalid value",
+        ),
+        (
+            Box::new(|v| v["photons"]["caustic_store"] = json!({"type": "octree"})),
+            "photons.caustic_store.type",
+            "unknown type",
+        ),
+        (
+            Box::new(|v| v["background"] = json!([0, f64::MAX, 0])),
+            "background",
+            "finite",
+        ),
+    ];
+    for (i, (edit, path, message)) in cases.into_iter().enumerate() {
+        let e = error_after(edit);
+        assert_eq!(e.path, path, "case {i}: {e}");
+        assert!(
+            e.message.contains(message),
+            "case {i}: {e} (wanted “{message}”)"
+        );
+    }
+    let e = parse_scene("{ \"camera\": ").unwrap_err();
+    assert!(e.message.starts_with("invalid JSON"), "{e}");
+    let e = parse_scene("[1, 2]").unwrap_err();
+    assert!(e.message.contains("invalid type"), "{e}");
+}
+
+/// The program exits with status 2 and names the JSON path on bad input; on good input
+/// it writes a PNG and a PFM and prints its statistics as one JSON object.
+#[test]
+fn the_program_reports_bad_input_with_exit_status_2() {
+    let dir = std::env::temp_dir().join(format!("caustic-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.json");
+    std::fs::write(
+        &bad,
+        read("glass_sphere.json").replace("\"radius\": 1.0", "\"radius\": 0"),
+    )
+    .unwrap();
+    let exe = env!("CARGO_BIN_EXE_caustic");
+    let out = std::process::Command::new(exe)
+        .args(["render", bad.to_str().unwrap(), "-o"])
+        .arg(dir.join("x.png"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("objects[1].radius"), "{stderr}");
+    let out = std::process::Command::new(exe)
+        .args(["render", "--bogus"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+
+    let scene = format!("{}/scenes/glass_sphere.json", env!("CARGO_MANIFEST_DIR"));
+    let (png, pfm) = (dir.join("g.png"), dir.join("g.pfm"));
+    let out = std::process::Command::new(exe)
+        .args([
+            "render",
+            &scene,
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--photons",
+            "5000",
+            "--stats",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&png)
+        .arg("--pfm")
+        .arg(&pfm)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (stats["width"].as_u64(), stats["height"].as_u64()),
+        (Some(40), Some(30))
+    );
+    assert_eq!(stats["photons"]["emitted"].as_u64(), Some(5000));
+    assert!(
+        stats["rays"]["eye"].as_u64().unwrap() >= 1200
+            && stats["time_ms"]["render"].as_f64().is_some()
+    );
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let img = caustic::desktop::Image::read_pfm(&pfm).unwrap();
+    assert_eq!((img.width, img.height), (40, 30));
+    let cmp = std::process::Command::new(exe)
+        .args(["compare"])
+        .arg(&pfm)
+        .arg(&pfm)
+        .output()
+        .unwrap();
+    let c: serde_json::Value = serde_json::from_slice(&cmp.stdout).unwrap();
+    assert_eq!(c["rel_rmse"].as_f64(), Some(0.0));
+    std::fs::remove_dir_all(dir).ok();
+}
