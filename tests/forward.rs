@@ -1,0 +1,240 @@
+//! The forward pass against analytic answers: photon density, energy through glass,
+//! and projection maps against full-sphere emission.
+
+use std::f64::consts::PI;
+
+use caustic::camera::Camera;
+use caustic::desktop::{parse_scene, DesktopScene, Image};
+use caustic::geometry::Shape;
+use caustic::light::PointLight;
+use caustic::material::{interface, Material};
+use caustic::math::{Rgb, UnitVec3, Vec3};
+use caustic::photon::{self, balance, store_over, CausticStore, KdTree, Photon, PhotonSettings};
+use caustic::render::Renderer;
+use caustic::scene::Scene;
+
+/// Shoots, balances and returns the photons and their power unit.
+fn photons<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    s: &PhotonSettings,
+    seed: u64,
+) -> (Vec<Photon>, f32, u64) {
+    let mut buf = vec![Photon::ZERO; photon::photons_needed(scene, s)];
+    let f = photon::shoot(scene, s, seed, 0, &mut buf).unwrap();
+    buf.truncate(f.stored);
+    balance(&mut buf);
+    (buf, f.power_unit, f.emitted)
+}
+
+fn camera() -> Camera {
+    Camera::new(Vec3::new(0.0, 5.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0, 8, 8).unwrap()
+}
+
+/// Direct photons stored on a plane: the estimate reproduces the analytic irradiance
+/// `I·cosθ/d²` within 3% away from the edges.
+#[test]
+fn density_estimate_reproduces_analytic_irradiance() {
+    let light = Vec3::new(0.0, 2.0, 0.0);
+    let intensity = 7.0f32;
+    let mut scene: Scene<1, 1> = Scene::new(camera());
+    scene
+        .add(
+            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
+            Material::diffuse(Rgb::ONE).unwrap(),
+        )
+        .unwrap();
+    scene
+        .add_light(PointLight::new(light, Rgb::splat(intensity)).unwrap())
+        .unwrap();
+    let settings = PhotonSettings::new(400_000, 400, 0.5, 4)
+        .unwrap()
+        .with_direct_photons(true);
+    let (map, unit, _) = photons(&scene, &settings, 11);
+    assert!(
+        map.len() > 190_000,
+        "half the sphere reaches the floor: {}",
+        map.len()
+    );
+    let store = store_over::<512>(KdTree::from_balanced(&map), unit, &settings).unwrap();
+    let mut worst = 0.0f64;
+    for i in 0..40 {
+        let a = i as f32 * 0.61;
+        let r = 0.05 * i as f32;
+        let x = Vec3::new(r * a.cos(), 0.0, r * a.sin());
+        let e = store.irradiance(x, UnitVec3::Y).r as f64;
+        let to = (light - x).as_dvec3();
+        let want = intensity as f64 * (to.y / to.length()) / to.length_squared();
+        worst = worst.max((e - want).abs() / want);
+        // Photons arrive from above: seen from below the floor, nothing.
+        assert_eq!(store.irradiance(x, -UnitVec3::Y), Rgb::ZERO);
+    }
+    eprintln!(
+        "density: worst relative error {:.3}% over 40 points",
+        worst * 100.0
+    );
+    assert!(worst < 0.03, "worst relative error {worst}");
+}
+
+/// A clear glass slab between a light and the floor: the flux stored below equals the
+/// flux the light sends onto the slab's top face times the slab's transmittance,
+/// `(1 − F)²/(1 − F²)` (both faces, with every order of internal reflection), integrated
+/// over the face by brute force.
+#[test]
+fn flux_through_a_glass_slab_matches_fresnel_transmission() {
+    let (ior, half, top, light_h, intensity) = (1.5f32, 3.0f32, 1.0f32, 2.0f32, 5.0f32);
+    let thickness = 0.02f32;
+    let mut scene: Scene<2, 1> = Scene::new(camera());
+    scene
+        .add(
+            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
+            Material::diffuse(Rgb::ONE).unwrap(),
+        )
+        .unwrap();
+    let slab = Shape::cuboid(
+        Vec3::new(0.0, top - 0.5 * thickness, 0.0),
+        Vec3::new(2.0 * half, thickness, 2.0 * half),
+        Vec3::ZERO,
+    );
+    scene
+        .add(slab.unwrap(), Material::dielectric(ior, Rgb::ZERO).unwrap())
+        .unwrap();
+    scene
+        .add_light(
+            PointLight::new(Vec3::new(0.0, top + light_h, 0.0), Rgb::splat(intensity)).unwrap(),
+        )
+        .unwrap();
+    let settings = PhotonSettings::new(300_000, 8, 0.1, 16).unwrap();
+    let (map, unit, emitted) = photons(&scene, &settings, 5);
+    assert_eq!(emitted, 300_000);
+    let stored: f64 = map.iter().map(|p| p.power().r as f64 * unit as f64).sum();
+
+    // ∫ over the top face of (I cos θ / d²) · T(θ), midpoint rule on a fine grid.
+    let n = 600;
+    let step = 2.0 * half as f64 / n as f64;
+    let mut want = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (x, z) = (
+                -half as f64 + (i as f64 + 0.5) * step,
+                -half as f64 + (j as f64 + 0.5) * step,
+            );
+            let d2 = x * x + z * z + (light_h as f64).powi(2);
+            let cos = light_h as f64 / d2.sqrt();
+            let d = UnitVec3::new(Vec3::new(x as f32, -light_h, z as f32)).unwrap();
+            let f = interface(d, UnitVec3::Y, 1.0 / ior).reflectance as f64;
+            want +=
+                intensity as f64 * cos / d2 * (1.0 - f) * (1.0 - f) / (1.0 - f * f) * step * step;
+        }
+    }
+    let rel = (stored - want) / want;
+    eprintln!(
+        "slab: stored {stored:.5} W, analytic {want:.5} W ({:+.3}%)",
+        rel * 100.0
+    );
+    // Noise: Russian roulette at ~2 interfaces over ~10⁵ photons gives σ ≈ 0.1%; light
+    // leaving through the slab's thin sides is below 0.1%.
+    assert!(
+        rel.abs() < 0.005,
+        "stored {stored:.5} W vs analytic {want:.5} W ({:+.3}%)",
+        rel * 100.0
+    );
+    // And never more than the light emitted.
+    assert!(stored < 4.0 * PI * intensity as f64);
+}
+
+/// The caustic term alone, as an image (direct light off), so that images compare
+/// the forward pass only.
+fn caustic_image(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> (Image, u64) {
+    let (map, unit, emitted) = photons(scene, settings, seed);
+    let store = store_over::<1024>(KdTree::from_balanced(&map), unit, settings).unwrap();
+    let cam = scene.camera();
+    let mut img = Image::new(cam.width(), cam.height());
+    let r: Renderer<_, 64, 16, 32> = Renderer::new(scene, &store, settings.max_depth()).unwrap();
+    for (y, row) in img.pixels.chunks_mut(cam.width() as usize).enumerate() {
+        r.row(y as u32, row);
+    }
+    (img, emitted)
+}
+
+/// Projection maps aim every photon at the objects that make caustics. The caustic they
+/// give equals the one from full-sphere emission with the same number of photons hitting
+/// the objects, to within the noise between two seeds, for a fraction of the photons.
+#[test]
+fn projection_maps_match_full_sphere_emission_for_a_fraction_of_the_work() {
+    let text = std::fs::read_to_string(format!(
+        "{}/scenes/glass_sphere.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let loaded = parse_scene(&text).unwrap();
+    let mut scene = loaded.scene;
+    // Only the caustic: light the floor with nothing else (a dark light would emit no
+    // photons, so keep the light but compare caustic-only images).
+    scene.set_camera(scene.camera().with_size(64, 48).unwrap());
+    let n = 40_000u32;
+    let maps = PhotonSettings::new(n, 64, 0.1, 8).unwrap();
+    // The sphere's cone from the light: Ω = 2π(1 − cos θ), sin θ = R/d.
+    let light = scene.lights()[0].position();
+    let d = (Vec3::new(0.0, 1.0, 0.0) - light).length() as f64;
+    let omega = 2.0 * PI * (1.0 - (1.0 - 1.0 / (d * d)).sqrt());
+    let full_n = (n as f64 * 4.0 * PI / omega).round() as u32;
+    let full = PhotonSettings::new(full_n, 64, 0.1, 8)
+        .unwrap()
+        .with_full_sphere(true);
+
+    let (a, emitted_a) = caustic_image(&scene, &maps, 1);
+    let (b, _) = caustic_image(&scene, &maps, 2);
+    let (c, emitted_c) = caustic_image(&scene, &full, 1);
+    assert!(
+        emitted_c as f64 > 10.0 * emitted_a as f64,
+        "maps save the photons that would miss"
+    );
+    let mean =
+        |img: &Image| img.pixels.iter().map(|p| p.r as f64).sum::<f64>() / img.pixels.len() as f64;
+    let rmse = |x: &Image, y: &Image| {
+        (x.pixels
+            .iter()
+            .zip(&y.pixels)
+            .map(|(p, q)| ((p.r - q.r) as f64).powi(2))
+            .sum::<f64>()
+            / x.pixels.len() as f64)
+            .sqrt()
+    };
+    assert!(mean(&a) > 0.0);
+    let noise = rmse(&a, &b);
+    let diff = rmse(&a, &c);
+    eprintln!("projection maps: rmse vs full sphere {diff:.5}, seed noise {noise:.5}, photons {emitted_a} vs {emitted_c}");
+    assert!(
+        diff < 1.5 * noise,
+        "maps vs full sphere {diff:.4} exceeds the seed-to-seed noise {noise:.4}"
+    );
+    // Total caustic light agrees within 2%.
+    assert!(
+        (mean(&a) - mean(&c)).abs() / mean(&c) < 0.02,
+        "{} vs {}",
+        mean(&a),
+        mean(&c)
+    );
+}
+
+/// A scene with nothing to focus light does no forward pass at all.
+#[test]
+fn a_scene_without_caustic_objects_shoots_nothing() {
+    let mut scene: Scene<1, 1> = Scene::new(camera());
+    scene
+        .add(
+            Shape::sphere(Vec3::ZERO, 1.0).unwrap(),
+            Material::diffuse(Rgb::ONE).unwrap(),
+        )
+        .unwrap();
+    scene
+        .add_light(PointLight::new(Vec3::Y * 3.0, Rgb::ONE).unwrap())
+        .unwrap();
+    let s = PhotonSettings::new(1000, 8, 0.1, 4).unwrap();
+    let mut buf = vec![Photon::ZERO; 1000];
+    let f = photon::shoot(&scene, &s, 0, 0, &mut buf).unwrap();
+    assert_eq!((f.emitted, f.stored), (0, 0));
+    // A budget larger than the storage is an error, not a truncation.
+    let mut small = vec![Photon::ZERO; 10];
+    assert!(photon::shoot(&scene, &s, 0, 0, &mut small).is_err());
+}
