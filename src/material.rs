@@ -194,31 +194,46 @@ pub struct Interface {
 /// Exact Fresnel reflectance and Snell refraction for unpolarised light.
 ///
 /// `d` is the travel direction, `n` the normal on the incident side (`d·n < 0`),
-/// `eta = eta_i / eta_t`. With `cos_i = −d·n` and `sin²t = η²(1 − cos²i)`: total internal
-/// reflection when `sin²t ≥ 1`; else `cos_t = √(1 − sin²t)`,
+/// `eta = eta_i / eta_t`. With `cos_i = −d·n`, Snell's law gives
+/// `cos²t = 1 − η²(1 − cos²i)`, evaluated as `(1 − η)(1 + η) + (η cos_i)²`, which does
+/// not cancel: with `η = 1` it is exactly `cos²i`, so the direction passes unchanged
+/// even at near-grazing incidence, where `1 − cos²i` would round to 1 and report total
+/// internal reflection. Total internal reflection when `cos²t ≤ 0` (or is undefined,
+/// as for an `η` that overflows); else `cos_t = √cos²t`,
 /// `t = η d + (η cos_i − cos_t) n` (the vector form of paper eqs. 3–6), and
 /// `F = ½(r_s² + r_p²)` with `r_s = (η_i cos_i − η_t cos_t)/(η_i cos_i + η_t cos_t)`,
 /// `r_p = (η_t cos_i − η_i cos_t)/(η_t cos_i + η_i cos_t)` (Born & Wolf; pbrt-v4 §9.5).
+/// Both denominators are positive whenever `cos²t > 0`, so `F` is never NaN.
 #[inline]
 pub fn interface(d: UnitVec3, n: UnitVec3, eta: f32) -> Interface {
     let cos_i = (-n.dot(d.get())).clamp(0.0, 1.0);
-    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
-    let sin2_t = eta * eta * sin2_i;
-    if sin2_t >= 1.0 {
+    let eta_cos_i = eta * cos_i;
+    let cos2_t = (1.0 - eta) * (1.0 + eta) + eta_cos_i * eta_cos_i;
+    if !(cos2_t > 0.0) {
         return Interface {
             reflectance: 1.0,
             refracted: None,
         };
     }
-    let cos_t = libm::sqrtf(1.0 - sin2_t);
+    let cos_t = libm::sqrtf(cos2_t.min(1.0));
     // In units of eta_t: eta_i = eta, eta_t = 1.
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rs = (eta_cos_i - cos_t) / (eta_cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let reflectance = (0.5 * (rs * rs + rp * rp)).clamp(0.0, 1.0);
-    let t = d.get() * eta + n.get() * (eta * cos_i - cos_t);
+    let reflectance = 0.5 * (rs * rs + rp * rp);
+    let reflectance = if reflectance.is_finite() {
+        reflectance.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let t = d.get() * eta + n.get() * (eta_cos_i - cos_t);
+    let refracted = UnitVec3::new(t);
     Interface {
-        reflectance,
-        refracted: UnitVec3::new(t),
+        reflectance: if refracted.is_some() {
+            reflectance
+        } else {
+            1.0
+        },
+        refracted,
     }
 }
 

@@ -132,20 +132,27 @@ impl Cylinder {
         let (t, n) = best?;
         let normal = UnitVec3::new(n)?;
         let p = ray.at(t);
-        // Re-project onto the surface that was hit: the side keeps its axial
-        // coordinate and moves radially to r; a cap keeps its radial offset.
+        // Re-project onto the patch of surface that was hit: the side keeps its axial
+        // coordinate, clamped to [0, h], and moves radially to r; a cap keeps its radial
+        // offset, clamped to the disk of radius r. The clamps matter when the ray starts
+        // far away: `ray.at(t)` then carries the rounding of the ray's coordinates,
+        // which may put it past the rim by more than the shape's own error bound.
         let rel = p - self.base;
         let z = self.axis.dot(rel);
-        let axial = self.axis.get() * z;
         let point = if normal.dot(self.axis.get()).abs() < 0.5 {
-            self.base + axial + normal.get() * self.radius
+            self.base + self.axis.get() * z.clamp(0.0, self.height) + normal.get() * self.radius
         } else {
             let zc = if normal.dot(self.axis.get()) > 0.0 {
                 self.height
             } else {
                 0.0
             };
-            self.base + (rel - axial) + self.axis.get() * zc
+            let mut radial = rel - self.axis.get() * z;
+            let r = radial.length();
+            if r > self.radius {
+                radial *= self.radius / r;
+            }
+            self.base + radial + self.axis.get() * zc
         };
         Some(Hit {
             t,
