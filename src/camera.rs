@@ -102,8 +102,15 @@ impl Camera {
     /// direction `normalize(forward + u·right + v·up)`.
     #[inline]
     pub fn ray(&self, x: u32, y: u32) -> Ray {
-        let u = (2.0 * (x as f32 + 0.5) / self.width as f32 - 1.0) * self.half_w;
-        let v = (1.0 - 2.0 * (y as f32 + 0.5) / self.height as f32) * self.half_h;
+        self.ray_at(x, y, 0.5, 0.5)
+    }
+
+    /// The ray through the point `(x + fx, y + fy)` of the image, `fx, fy ∈ [0, 1)` the
+    /// position inside pixel `(x, y)` (`½, ½` is its centre: [`ray`](Self::ray)).
+    #[inline]
+    pub fn ray_at(&self, x: u32, y: u32, fx: f32, fy: f32) -> Ray {
+        let u = (2.0 * (x as f32 + fx) / self.width as f32 - 1.0) * self.half_w;
+        let v = (1.0 - 2.0 * (y as f32 + fy) / self.height as f32) * self.half_h;
         let d = self.forward + self.right * u + self.up * v;
         // |d| ≥ 1 because forward is unit and orthogonal to right and up.
         Ray::new(self.position, UnitVec3::new_unchecked(d.normalize()))

@@ -56,6 +56,8 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     scene: &'a Scene<OBJECTS, LIGHTS>,
     store: &'a S,
     max_depth: u32,
+    /// Eye rays per pixel side: `n × n` per pixel.
+    samples: u32,
 }
 
 impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
@@ -74,7 +76,24 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             scene,
             store,
             max_depth,
+            samples: 1,
         })
+    }
+
+    /// Supersampling: `n × n` eye rays per pixel on a regular grid of sub-pixel centres,
+    /// averaged (a box filter: the pixel-area average a sensor records). `n = 1`, the
+    /// default, is the one ray through the pixel centre of the scene format.
+    pub fn with_supersample(mut self, n: u32) -> Result<Self, Error> {
+        if !(1..=64).contains(&n) {
+            return Err(Error::OutOfRange {
+                what: "supersample",
+                value: n as f32,
+                min: 1.0,
+                max: 64.0,
+            });
+        }
+        self.samples = n;
+        Ok(self)
     }
 
     /// The scene.
@@ -236,8 +255,23 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
         let mut count = RayCount::default();
         let camera = self.scene.camera();
+        let n = self.samples;
+        if n == 1 {
+            for (x, px) in row.iter_mut().enumerate() {
+                *px = self.radiance(camera.ray(x as u32, y), &mut count);
+            }
+            return count;
+        }
+        let (step, inv) = (1.0 / n as f32, 1.0 / (n * n) as f32);
         for (x, px) in row.iter_mut().enumerate() {
-            *px = self.radiance(camera.ray(x as u32, y), &mut count);
+            let mut sum = Rgb::ZERO;
+            for sy in 0..n {
+                for sx in 0..n {
+                    let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
+                    sum += self.radiance(camera.ray_at(x as u32, y, fx, fy), &mut count);
+                }
+            }
+            *px = sum * inv;
         }
         count
     }

@@ -4,8 +4,8 @@
 //! caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
 //!                [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
 //!                [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-//!                [--exposure E] [--stats] [--quiet]
-//! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F]
+//!                [--exposure E] [--supersample S] [--stats] [--quiet]
+//! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]
 //! ```
 //! Exit status: 0 on success, 2 on bad input (scene, flags, files), 1 otherwise.
 
@@ -22,8 +22,8 @@ const USAGE: &str = "usage:
   caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
                  [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
                  [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-                 [--exposure E] [--stats] [--quiet]
-  caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F]";
+                 [--exposure E] [--supersample S] [--stats] [--quiet]
+  caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]";
 
 /// A failure and its exit status.
 struct Failure {
@@ -130,6 +130,7 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     let seed: u64 = f.value(&["--seed"])?.unwrap_or(0);
     let threads: Option<usize> = f.value(&["--threads"])?;
     let exposure: f32 = f.value(&["--exposure"])?.unwrap_or(1.0);
+    let supersample: u32 = f.value(&["--supersample"])?.unwrap_or(1);
     let want_stats = f.switch("--stats");
     let quiet = f.switch("--quiet");
     let pos = f.positional()?;
@@ -179,6 +180,7 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
         progress: !quiet,
         passes: passes.unwrap_or(loaded.passes).max(1),
         alpha,
+        supersample,
     };
     let parse_ms = t0.elapsed().as_secs_f64() * 1e3;
     let (image, stats) = render(&scene, &settings, &opts).map_err(|e| bad_input(e.to_string()))?;
@@ -236,12 +238,13 @@ fn cmd_compare(args: &[String]) -> Result<(), Failure> {
     let mut f = Flags::new(args);
     let mask_path: Option<PathBuf> = f.value(&["--mask"])?;
     let fraction: f32 = f.value(&["--mask-fraction"])?.unwrap_or(0.1);
+    let bin: u32 = f.value(&["--bin"])?.unwrap_or(1);
     let pos = f.positional()?;
     let [a, b] = pos.as_slice() else {
         return Err(bad_input(format!("compare takes two PFM files\n{USAGE}")));
     };
     let read = |p: &String| Image::read_pfm(p.as_ref()).map_err(|e| bad_input(e.to_string()));
-    let (a, b) = (read(a)?, read(b)?);
+    let (a, b) = (read(a)?.binned(bin), read(b)?.binned(bin));
     if (a.width, a.height) != (b.width, b.height) {
         return Err(bad_input(format!(
             "sizes differ: {}×{} vs {}×{}",
@@ -254,7 +257,9 @@ fn cmd_compare(args: &[String]) -> Result<(), Failure> {
         full.rel_rmse, full.rel_mae, full.pixels
     );
     if let Some(m) = mask_path {
-        let m = Image::read_pfm(&m).map_err(|e| bad_input(e.to_string()))?;
+        let m = Image::read_pfm(&m)
+            .map_err(|e| bad_input(e.to_string()))?
+            .binned(bin);
         if (m.width, m.height) != (a.width, a.height) {
             return Err(bad_input("the mask's size differs from the images'"));
         }

@@ -31,6 +31,8 @@ pub struct RenderOptions {
     pub passes: u32,
     /// Radius shrink exponent α of the passes: `r_i² = r_1²·i^(α−1)`.
     pub alpha: f32,
+    /// Eye rays per pixel side (`n × n` per pixel), ≥ 1.
+    pub supersample: u32,
 }
 
 impl Default for RenderOptions {
@@ -41,6 +43,7 @@ impl Default for RenderOptions {
             progress: false,
             passes: 1,
             alpha: 2.0 / 3.0,
+            supersample: 1,
         }
     }
 }
@@ -104,62 +107,66 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// The balanced photons of one forward pass, on the heap.
+/// The photon array of the forward pass, on the heap: allocated once for a budget and
+/// refilled in place by every progressive pass (fixed memory, Knaus & Zwicker 2011).
 #[derive(Debug)]
-pub struct PhotonPass {
+pub struct PhotonBuffer {
     photons: vec::Vec<Photon>,
+    len: usize,
     unit: f32,
-    emitted: u64,
 }
 
-impl PhotonPass {
-    /// The balanced tree.
+impl PhotonBuffer {
+    /// Room for one forward pass of `settings` over `scene`; an error beyond
+    /// [`MAX_PHOTONS`].
+    pub fn for_budget(scene: &DesktopScene, settings: &PhotonSettings) -> Result<Self, Error> {
+        let needed = photons_needed(scene, settings);
+        if needed > MAX_PHOTONS {
+            return Err(Error::Capacity {
+                what: "photons (count × lights)",
+                requested: needed,
+                capacity: MAX_PHOTONS,
+            });
+        }
+        Ok(Self {
+            photons: vec![Photon::ZERO; needed],
+            len: 0,
+            unit: 0.0,
+        })
+    }
+
+    /// Runs forward pass `pass` into the buffer and balances it, adding the times and
+    /// counts to `stats`.
+    pub fn fill(
+        &mut self,
+        scene: &DesktopScene,
+        settings: &PhotonSettings,
+        seed: u64,
+        pass: u32,
+        stats: &mut RenderStats,
+    ) -> Result<(), Error> {
+        let t = Instant::now();
+        let f = photon::shoot(scene, settings, seed, pass, &mut self.photons)?;
+        stats.emit_ms += ms(t.elapsed());
+        let t = Instant::now();
+        balance(&mut self.photons[..f.stored]);
+        stats.balance_ms += ms(t.elapsed());
+        stats.photons_emitted += f.emitted;
+        stats.photons_stored += f.stored as u64;
+        self.len = f.stored;
+        self.unit = f.power_unit;
+        Ok(())
+    }
+
+    /// The balanced tree of the last pass.
     pub fn tree(&self) -> KdTree<'_> {
-        KdTree::from_balanced(&self.photons)
+        KdTree::from_balanced(&self.photons[..self.len])
     }
 
     /// Power of one stored unit, W.
     pub fn unit(&self) -> f32 {
         self.unit
     }
-
-    /// Photons emitted.
-    pub fn emitted(&self) -> u64 {
-        self.emitted
-    }
-}
-
-/// Runs forward pass `pass` into a heap array and balances it, adding the times to `stats`.
-pub fn photon_pass(
-    scene: &DesktopScene,
-    settings: &PhotonSettings,
-    seed: u64,
-    pass: u32,
-    stats: &mut RenderStats,
-) -> Result<PhotonPass, Error> {
-    let needed = photons_needed(scene, settings);
-    if needed > MAX_PHOTONS {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: MAX_PHOTONS,
-        });
-    }
-    let t = Instant::now();
-    let mut photons = vec![Photon::ZERO; needed];
-    let f = photon::shoot(scene, settings, seed, pass, &mut photons)?;
-    photons.truncate(f.stored);
-    stats.emit_ms += ms(t.elapsed());
-    let t = Instant::now();
-    balance(&mut photons);
-    stats.balance_ms += ms(t.elapsed());
-    stats.photons_emitted += f.emitted;
-    stats.photons_stored += f.stored as u64;
-    Ok(PhotonPass {
-        photons,
-        unit: f.power_unit,
-        emitted: f.emitted,
-    })
 }
 
 /// Renders `scene` with the forward and backward passes, on `opts.threads` threads.
@@ -184,11 +191,16 @@ pub fn render(
         opts.progress && std::io::stderr().is_terminal(),
         h as usize * passes as usize,
     );
+    // Progressive passes gather with a fixed radius (a k-nearest radius would not
+    // shrink with the passes, and the average would keep its bias).
+    let settings = &settings.with_fixed_radius(settings.fixed_radius() || passes > 1);
+    let mut photons = PhotonBuffer::for_budget(scene, settings)?;
+    let mut image = Image::new(w, h);
     for pass in 0..passes {
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
         let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
-        let photons = photon_pass(scene, &pass_settings, opts.seed, pass, &mut stats)?;
+        photons.fill(scene, &pass_settings, opts.seed, pass, &mut stats)?;
         let store =
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
         let timed = Timed {
@@ -196,19 +208,15 @@ pub fn render(
             nanos: AtomicU64::new(0),
         };
         let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
-            Renderer::new(scene, &timed, settings.max_depth())?;
+            Renderer::new(scene, &timed, settings.max_depth())?
+                .with_supersample(opts.supersample)?;
         let t = Instant::now();
-        let mut image = Image::new(w, h);
         let rays = render_rows(&renderer, &mut image, threads, &progress);
         stats.render_ms += ms(t.elapsed());
         stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
         stats.rays += rays;
-        if passes == 1 {
-            sum = image;
-        } else {
-            for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
-                *s += *p;
-            }
+        for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
+            *s += *p;
         }
     }
     progress.finish();

@@ -27,31 +27,35 @@ impl ConeFilter {
 }
 
 /// A kd-tree photon map used as a caustic store, gathering up to `K` photons
-/// (the compiled capacity of the gather; `k ≤ K` photons are used).
+/// (the compiled capacity of the gather; `k ≤ K` photons are used), or every photon
+/// within a fixed radius.
 #[derive(Clone, Copy, Debug)]
 pub struct KdStore<'a, const K: usize> {
     tree: KdTree<'a>,
     /// Power of one unit of stored photon power, W.
     unit: f32,
-    k: usize,
+    /// Photons per estimate; `None`: all within the radius.
+    k: Option<usize>,
     max_radius2: f32,
     cone: Option<ConeFilter>,
 }
 
 impl<'a, const K: usize> KdStore<'a, K> {
-    /// A store over a balanced tree whose photon powers are in units of `unit` W.
-    /// `k` is clamped to `1..=K`.
+    /// A store over a balanced tree whose photon powers are in units of `unit` W,
+    /// gathering the `k` nearest photons (clamped to `1..=K`) within `max_radius`, or,
+    /// with `k = None`, every photon within `max_radius` (the fixed-radius gather of
+    /// progressive photon mapping, which needs no gather buffer).
     pub fn new(
         tree: KdTree<'a>,
         unit: f32,
-        k: usize,
+        k: Option<usize>,
         max_radius: f32,
         cone: Option<ConeFilter>,
     ) -> Self {
         Self {
             tree,
             unit,
-            k: k.clamp(1, K.max(1)),
+            k: k.map(|k| k.clamp(1, K.max(1))),
             max_radius2: max_radius * max_radius,
             cone,
         }
@@ -62,9 +66,10 @@ impl<'a, const K: usize> KdStore<'a, K> {
         &self.tree
     }
 
-    /// Gathers the k nearest photons around `x` and sums `weight(photon)` over those
-    /// that arrived on the front of the surface of normal `n`, with the cone filter if
-    /// any. Returns the sum (in W, including the filter's normalisation) and r².
+    /// Gathers the photons around `x` — the k nearest within the maximum radius, or with
+    /// a fixed radius every photon within it — and sums `weight(photon)` over those that
+    /// arrived on the front of the surface of normal `n`, with the cone filter if any.
+    /// Returns the sum (in W, including the filter's normalisation) and r².
     #[inline]
     fn gather(
         &self,
@@ -72,31 +77,48 @@ impl<'a, const K: usize> KdStore<'a, K> {
         n: UnitVec3,
         mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
-        let mut buf = [Neighbor::default(); K];
-        let found = self.tree.k_nearest(x, self.max_radius2, &mut buf[..self.k]);
-        let r2 = found.radius2;
-        let mut sum = Rgb::ZERO;
         let photons = self.tree.photons();
-        let (inv_kr, norm) = match self.cone {
+        let filter = |r2: f32| match self.cone {
             Some(c) => (
                 1.0 / (c.k * libm::sqrtf(r2)),
                 1.0 / (1.0 - 2.0 / (3.0 * c.k)),
             ),
             None => (0.0, 1.0),
         };
-        for nb in &buf[..found.count] {
-            let p = &photons[nb.index as usize];
+        let mut sum = Rgb::ZERO;
+        let mut add = |index: usize, dist2: f32, inv_kr: f32| {
+            let p = &photons[index];
             let dir = p.direction();
             if n.dot(dir.get()) >= 0.0 {
-                continue; // arrived from behind the surface
+                return; // arrived from behind the surface
             }
             let w = if self.cone.is_some() {
-                1.0 - libm::sqrtf(nb.dist2) * inv_kr
+                1.0 - libm::sqrtf(dist2) * inv_kr
             } else {
                 1.0
             };
             sum += weight(dir, p.power()) * w;
-        }
+        };
+        let (r2, norm) = match self.k {
+            Some(k) => {
+                let mut buf = [Neighbor::default(); K];
+                let found = self.tree.k_nearest(x, self.max_radius2, &mut buf[..k]);
+                let (inv_kr, norm) = filter(found.radius2);
+                for nb in &buf[..found.count] {
+                    add(nb.index as usize, nb.dist2, inv_kr);
+                }
+                (found.radius2, norm)
+            }
+            None => {
+                let r2 = self.max_radius2;
+                let (inv_kr, norm) = filter(r2);
+                self.tree.search(x, r2, |index, dist2| {
+                    add(index, dist2, inv_kr);
+                    r2
+                });
+                (r2, norm)
+            }
+        };
         (sum * (self.unit * norm), r2)
     }
 }

@@ -63,6 +63,7 @@ pub struct PhotonSettings {
     cone: Option<ConeFilter>,
     full_sphere: bool,
     store_direct: bool,
+    fixed_radius: bool,
 }
 
 impl PhotonSettings {
@@ -86,6 +87,7 @@ impl PhotonSettings {
             cone: None,
             full_sphere: false,
             store_direct: false,
+            fixed_radius: false,
         })
     }
 
@@ -108,6 +110,18 @@ impl PhotonSettings {
     pub fn with_direct_photons(mut self, store_direct: bool) -> Self {
         self.store_direct = store_direct;
         self
+    }
+
+    /// Gathers every photon within `max_radius` instead of the `k` nearest: the
+    /// estimate of progressive photon mapping, whose radius shrinks pass by pass.
+    pub fn with_fixed_radius(mut self, fixed_radius: bool) -> Self {
+        self.fixed_radius = fixed_radius;
+        self
+    }
+
+    /// `true` when every photon within `max_radius` is gathered.
+    pub fn fixed_radius(&self) -> bool {
+        self.fixed_radius
     }
 
     /// A copy with another maximum radius (progressive passes shrink it).
@@ -310,17 +324,18 @@ pub fn store_over<'a, const K: usize>(
     unit: f32,
     settings: &PhotonSettings,
 ) -> Result<KdStore<'a, K>, Error> {
-    if settings.k as usize > K {
+    if !settings.fixed_radius && settings.k as usize > K {
         return Err(Error::Capacity {
             what: "photons.k (gather size)",
             requested: settings.k as usize,
             capacity: K,
         });
     }
+    let k = (!settings.fixed_radius).then_some(settings.k as usize);
     Ok(KdStore::new(
         tree,
         unit,
-        settings.k as usize,
+        k,
         settings.max_radius,
         settings.cone,
     ))
