@@ -49,8 +49,10 @@
 //!     --features embedded-graphics-simulator/with-sdl -- --window
 //! ```
 //!
-//! (This adds `sdl2` to your `Cargo.lock`.) Without the backend `--window` shows
-//! nothing; the PNG is written either way.
+//! (Checked on Debian 12 under Xvfb.) In the window each row is presented as it
+//! leaves the renderer, at most 60 rows a second (the simulator's frame limiter), so
+//! the picture builds up top to bottom as on the panel. Without the backend
+//! `--window` shows nothing; the PNG is written either way.
 
 use std::error::Error;
 use std::path::{Path, PathBuf};
