@@ -44,18 +44,18 @@ check() { # name bytes limit
 }
 
 echo "== device budget ($(basename "$elf"), thumbv7em-none-eabihf)"
-printf '%-34s %10s %12s  %-9s %s\n' "what" "bytes" "" "target" ""
-printf '%-34s %10d %12s  %-9s %s\n' "flash (.vector_table+.text+.rodata+.data)" "$flash" "$(kib "$flash")" "64 KiB" "$(check flash "$flash" 65536)"
-printf '%-34s %10s %12s\n' "  .vector_table / .text / .rodata" "" "$vt / $text / $rodata"
-printf '%-34s %10d %12s  %-9s %s\n' "static RAM (.data+.bss+.uninit)" "$ram" "$(kib "$ram")" "64 KiB" "$(check ram "$ram" 65536)"
-printf '%-34s %10s %12s\n' "  of which the photon map (static)" "${map:-?}" "$(kib "${map:-0}")"
-printf '%-34s %10d %12s  %-9s %s\n' "stack high-water (measured)" "$stack" "$(kib "$stack")" "8 KiB" "$(check stack "$stack" 8192)"
+printf '%-42s %10s %12s  %-9s %s\n' "what" "bytes" "" "target" ""
+printf '%-42s %10d %12s  %-9s %s\n' "flash (.vector_table+.text+.rodata+.data)" "$flash" "$(kib "$flash")" "64 KiB" "$(check flash "$flash" 65536)"
+printf '%-42s %10s %12s\n' "  .vector_table / .text / .rodata" "" "$vt / $text / $rodata"
+printf '%-42s %10d %12s  %-9s %s\n' "static RAM (.data+.bss+.uninit)" "$ram" "$(kib "$ram")" "64 KiB" "$(check ram "$ram" 65536)"
+printf '%-42s %10s %12s\n' "  of which the photon map (static)" "${map:-?}" "$(kib "${map:-0}")"
+printf '%-42s %10d %12s  %-9s %s\n' "stack high-water (measured)" "$stack" "$(kib "$stack")" "8 KiB" "$(check stack "$stack" 8192)"
 
 if [[ -n "$profile" ]]; then
     eval "$(python3 "$here/profile.py" --summary-only "$elf" "$profile")"
-    printf '%-34s %10s\n' "instructions, render (160x120)" "$insns_render"
-    printf '%-34s %10s\n' "instructions, forward pass" "$insns_photons"
-    printf '%-34s %10s\n' "instructions, whole run" "$insns_total"
+    printf '%-42s %10s\n' "instructions, render (160x120)" "$insns_render"
+    printf '%-42s %10s\n' "instructions, forward pass" "$insns_photons"
+    printf '%-42s %10s\n' "instructions, whole run" "$insns_total"
 fi
 if [[ -n "$host_log" ]]; then
     grep '^size_of ' "$host_log" | sed 's/^/  /' || true
