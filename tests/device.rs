@@ -62,7 +62,10 @@ impl DrawTarget for Memory565 {
     type Color = Rgb565;
     type Error = core::convert::Infallible;
 
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
         let (w, h) = (self.size.width as i32, self.size.height as i32);
         for Pixel(p, c) in pixels {
             assert!(
@@ -79,9 +82,9 @@ impl DrawTarget for Memory565 {
 
 /// FNV-1a, 32 bits: the firmware's checksum.
 fn fnv1a(bytes: &[u8]) -> u32 {
-    bytes
-        .iter()
-        .fold(0x811c_9dc5u32, |h, &b| (h ^ b as u32).wrapping_mul(0x0100_0193))
+    bytes.iter().fold(0x811c_9dc5u32, |h, &b| {
+        (h ^ b as u32).wrapping_mul(0x0100_0193)
+    })
 }
 
 /// The firmware's render, on the host: RGB565 bytes, rows handed to the sink, and
@@ -112,7 +115,11 @@ fn render_like_the_device() -> (Memory565, Vec<u32>, usize) {
 #[test]
 fn device_image_is_the_host_image_bit_for_bit() {
     let (display, rows, stored) = render_like_the_device();
-    assert_eq!(rows, (0..HEIGHT).collect::<Vec<_>>(), "rows top to bottom, once each");
+    assert_eq!(
+        rows,
+        (0..HEIGHT).collect::<Vec<_>>(),
+        "rows top to bottom, once each"
+    );
     assert!(
         display.writes.iter().all(|&n| n == 1),
         "every pixel written exactly once"
@@ -124,7 +131,10 @@ fn device_image_is_the_host_image_bit_for_bit() {
     if let Ok(expected) = std::env::var("CAUSTIC_DEVICE_FNV1A") {
         let expected = u32::from_str_radix(expected.trim().trim_start_matches("0x"), 16)
             .expect("CAUSTIC_DEVICE_FNV1A is a hex u32");
-        assert_eq!(hash, expected, "the host's hash against the firmware's PASS line");
+        assert_eq!(
+            hash, expected,
+            "the host's hash against the firmware's PASS line"
+        );
     }
     match std::env::var_os("CAUSTIC_DEVICE_RGB565") {
         None => println!("CAUSTIC_DEVICE_RGB565 not set: skipped the comparison with the device"),

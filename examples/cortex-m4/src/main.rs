@@ -122,7 +122,14 @@ impl HostFile {
         // SAFETY: SYS_OPEN reads `len` bytes of the NUL-terminated name at `ptr`,
         // which lives across the call.
         #[allow(unsafe_code)]
-        let fd = unsafe { syscall!(OPEN, path.as_ptr(), nr::open::W_TRUNC_BINARY, path.len() - 1) };
+        let fd = unsafe {
+            syscall!(
+                OPEN,
+                path.as_ptr(),
+                nr::open::W_TRUNC_BINARY,
+                path.len() - 1
+            )
+        };
         if fd as isize == -1 {
             return Err(HostIoError("SYS_OPEN"));
         }
@@ -231,8 +238,14 @@ fn output_path(buf: &mut [u8; 256]) -> &[u8] {
     // and the length into `block[1]`; both live across the call.
     #[allow(unsafe_code)]
     let r = unsafe { syscall1!(GET_CMDLINE, block.as_mut_ptr()) };
-    let line: &[u8] = if r == 0 { &buf[..block[1].min(buf.len())] } else { &[] };
-    let mut words = line.split(|&b| b == b' ' || b == 0).filter(|w| !w.is_empty());
+    let line: &[u8] = if r == 0 {
+        &buf[..block[1].min(buf.len())]
+    } else {
+        &[]
+    };
+    let mut words = line
+        .split(|&b| b == b' ' || b == 0)
+        .filter(|w| !w.is_empty());
     let path = words.nth(1).unwrap_or(DEFAULT_PATH);
     let mut out = [0u8; 256];
     let n = path.len().min(255);
@@ -292,10 +305,18 @@ fn fail(what: &str) -> ! {
 
 #[entry]
 fn main() -> ! {
-    hprintln!("caustic on Cortex-M4F: Fig. 6, {}x{}, seed {}", WIDTH, HEIGHT, SEED);
+    hprintln!(
+        "caustic on Cortex-M4F: Fig. 6, {}x{}, seed {}",
+        WIDTH,
+        HEIGHT,
+        SEED
+    );
     let mut path_buf = [0u8; 256];
     let path = output_path(&mut path_buf);
-    hprintln!("output: {}", core::str::from_utf8(&path[..path.len() - 1]).unwrap_or("?"));
+    hprintln!(
+        "output: {}",
+        core::str::from_utf8(&path[..path.len() - 1]).unwrap_or("?")
+    );
 
     let scene = demo::fig6::<2, 1>(WIDTH, HEIGHT).unwrap_or_else(|_| fail("scene"));
     let settings = demo::device_settings().unwrap_or_else(|_| fail("settings"));
@@ -331,11 +352,20 @@ fn main() -> ! {
     let (pixels, hash) = display.close().unwrap_or_else(|e| fail(e.0));
     hprintln!("rays: {} eye, {} shadow", rays.eye, rays.shadow);
     let (stack, stack_region) = stack_high_water();
-    hprintln!("stack high-water: {} bytes (of {} reserved)", stack, stack_region);
+    hprintln!(
+        "stack high-water: {} bytes (of {} reserved)",
+        stack,
+        stack_region
+    );
     if pixels != WIDTH * HEIGHT {
         fail("not every pixel was written");
     }
-    hprintln!("PASS fnv1a=0x{:08x} pixels={} stack={}", hash, pixels, stack);
+    hprintln!(
+        "PASS fnv1a=0x{:08x} pixels={} stack={}",
+        hash,
+        pixels,
+        stack
+    );
     debug::exit(debug::EXIT_SUCCESS);
     loop {
         cortex_m::asm::bkpt();
