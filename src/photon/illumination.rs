@@ -1,0 +1,675 @@
+//! Illumination maps (Arvo 1986; the paper's section 3.1): the second caustic store.
+//!
+//! Instead of keeping photons and gathering the nearest ones at every eye hit, each
+//! diffuse object gets 2D arrays of texels over a `(u, v)` parameterisation of its
+//! surface (see [`chart`](self#charts)). Every photon is *splatted* into the four
+//! texels around its `(u, v)`, bilinearly and exactly as the paper describes: its energy
+//! is first shared between the two parallel texel rows around it (the two points on each
+//! parallel line), then each row's part between the two texels on that row. When all
+//! photons are in, each texel's energy is divided by the **true surface area** it
+//! represents — the integral over the surface of its splat weight, computed
+//! analytically (non-uniform on a sphere, a cylinder's cap) — giving irradiance in
+//! W/m². A lookup reconstructs the irradiance bilinearly from the same four texels.
+//!
+//! Because splat and lookup use the same weights and areas, a single photon's energy
+//! is conserved by the round trip (`∫ E dA = Φ`), and a uniform flux gives an
+//! unbiased flat map on every shape.
+//!
+//! Memory is fixed: all charts share one texel array (`Rgb`, 12 bytes a texel) of
+//! compiled capacity ([`FixedIlluminationMaps`]) or, on the desktop, of the size the
+//! layout needs (`Vec<Rgb>`). No photon array is needed: [`IlluminationMaps::build`]
+//! re-runs the (deterministic) forward pass instead of storing photons.
+//!
+//! # Charts
+//! - **plane**: a rectangle of the plane in the basis `(e1, e2)` = [`UnitVec3::basis`]
+//!   of its normal, the bounding rectangle of the photons that landed on its front,
+//!   trimmed of outliers by [`IlluminationMaps::with_trim`] (photons outside it are
+//!   dropped and counted in [`MapStats::dropped`]); texels exactly `texel_size` square
+//!   (the paper's "scale").
+//! - **sphere**: paper eq. 7, `P(u, v) = c + r·(cos v cos u, sin v, cos v sin u)` (the
+//!   paper's `z` axis is the scene's up, `y`), longitude `u ∈ [0, 2π)` (periodic),
+//!   latitude `v ∈ [−π/2, π/2]`; `⌈2πr/s⌉ × ⌈πr/s⌉` texels, texel area
+//!   `r²·Δu·∫ w(v) cos v dv`.
+//! - **box**: each face its own grid, in the box's frame.
+//! - **cylinder**: the side (angle × height, area `r·Δθ·Δz`), and each cap in polar
+//!   coordinates (angle × radius, area `Δθ·∫ w(ρ)·ρ dρ`).
+//!
+//! Only objects that store photons (a diffuse part) and received at least one photon
+//! get texels. A point is matched to the object whose surface is nearest (within
+//! `1e-4·max(1, |x|∞)`), the chart of a box face or cylinder cap by the normal.
+//!
+//! # The classic model
+//! The paper's eq. 8 needs each photon's direction `l`. A texel keeps no direction, so
+//! [`CausticStore::classic`] takes `l = n` (light arriving along the normal):
+//! `c ≈ π·E·kernel(n, n, to_eye)`, the kd-tree's `Σ kernel·Φ/r²` with every photon
+//! at normal incidence. This overestimates the diffuse term by `1/cos θ` for light
+//! arriving at angle `θ` and puts the highlight where the mirror direction of `n` is.
+//!
+//! # Front side
+//! As in the kd-tree store, only photons arriving on the front (`dir·n < 0`, `n` the
+//! outward normal of the chart) are splatted, and a lookup with a normal facing away
+//! from the chart's returns zero.
+
+mod chart;
+
+use core::f32::consts::PI;
+
+use heapless::Vec as FixedVec;
+
+use self::chart::{bounded_grids, distance, locate, pair, Grid, Located, Profile};
+use super::emit::Emission;
+use super::{trace, CausticStore, ForwardStats, Photon, PhotonSettings};
+use crate::error::{positive, Error};
+use crate::geometry::{Ray, Shape};
+use crate::material::Classic;
+use crate::math::{max_abs, Rgb, UnitVec3, Vec3};
+use crate::sampling::{hash, unit_f32, Pcg32};
+use crate::scene::Scene;
+
+/// Where the texels live: a fixed array on the device, a `Vec` on the desktop.
+pub trait TexelStorage {
+    /// All texels.
+    fn texels(&self) -> &[Rgb];
+    /// All texels, mutable.
+    fn texels_mut(&mut self) -> &mut [Rgb];
+    /// Makes room for `needed` texels: an error when a fixed storage is too small.
+    fn reserve(&mut self, needed: usize) -> Result<(), Error>;
+}
+
+impl<const N: usize> TexelStorage for [Rgb; N] {
+    fn texels(&self) -> &[Rgb] {
+        self
+    }
+    fn texels_mut(&mut self) -> &mut [Rgb] {
+        self
+    }
+    fn reserve(&mut self, needed: usize) -> Result<(), Error> {
+        if needed > N {
+            return Err(Error::Capacity {
+                what: "illumination map texels",
+                requested: needed,
+                capacity: N,
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(feature = "std")]
+impl TexelStorage for std::vec::Vec<Rgb> {
+    fn texels(&self) -> &[Rgb] {
+        self
+    }
+    fn texels_mut(&mut self) -> &mut [Rgb] {
+        self
+    }
+    fn reserve(&mut self, needed: usize) -> Result<(), Error> {
+        self.clear();
+        self.resize(needed, Rgb::ZERO);
+        self.shrink_to_fit();
+        Ok(())
+    }
+}
+
+const NO_GRID: Grid = Grid {
+    offset: 0,
+    w: 0,
+    h: 0,
+    u0: 0.0,
+    du: 1.0,
+    v0: 0.0,
+    dv: 1.0,
+    periodic_u: false,
+    profile: Profile::Flat(1.0),
+};
+
+/// Bins per axis of the histogram that trims a plane's rectangle.
+const TRIM_BINS: usize = 256;
+
+/// One diffuse object's charts.
+#[derive(Clone, Copy, Debug)]
+struct ObjectMap {
+    shape: Shape,
+    /// Index of the object in the scene.
+    object: usize,
+    grids: [Grid; 6],
+    /// Grids laid out (0 until the layout, and for an object without photons).
+    charts: u8,
+    /// Front-side photons that landed on it (layout pass).
+    photons: u32,
+    /// A plane's photon rectangle in `(u, v)`: min and max.
+    lo: [f32; 2],
+    hi: [f32; 2],
+}
+
+/// What building the maps did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MapStats {
+    /// Photons splatted.
+    pub splatted_photons: u64,
+    /// Their energy, W.
+    pub splatted: Rgb,
+    /// Photons dropped: behind a surface, on no mapped object, outside a plane's rectangle.
+    pub dropped_photons: u64,
+    /// Their energy, W.
+    pub dropped: Rgb,
+    /// Texels laid out.
+    pub texels: usize,
+    /// Diffuse objects with texels.
+    pub mapped_objects: usize,
+}
+
+/// Illumination maps of the diffuse objects of a scene, in one texel storage `S`
+/// shared by every object's charts, for at most `OBJECTS` diffuse objects.
+///
+/// Build with [`build`](Self::build) (no photon array: the forward pass is re-run) or
+/// [`build_from_photons`](Self::build_from_photons); then use it as a [`CausticStore`].
+#[derive(Clone, Debug)]
+pub struct IlluminationMaps<S, const OBJECTS: usize> {
+    texels: S,
+    objects: FixedVec<ObjectMap, OBJECTS>,
+    texel_size: f32,
+    trim: f32,
+    used: usize,
+    stats: MapStats,
+}
+
+/// Illumination maps in a fixed array of `TEXELS` texels (12 bytes each), for at most
+/// `OBJECTS` diffuse objects: `size_of` is the whole memory (no photon array needed).
+pub type FixedIlluminationMaps<const TEXELS: usize, const OBJECTS: usize> =
+    IlluminationMaps<[Rgb; TEXELS], OBJECTS>;
+
+impl<const TEXELS: usize, const OBJECTS: usize> FixedIlluminationMaps<TEXELS, OBJECTS> {
+    /// Empty maps of texel side `texel_size` (scene units, > 0).
+    pub fn fixed(texel_size: f32) -> Result<Self, Error> {
+        Self::new([Rgb::ZERO; TEXELS], texel_size)
+    }
+}
+
+impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
+    /// Empty maps over `texels`, of texel side `texel_size` (scene units, > 0), with the
+    /// default outlier trim of plane rectangles (see [`with_trim`](Self::with_trim)).
+    pub fn new(texels: S, texel_size: f32) -> Result<Self, Error> {
+        Ok(Self {
+            texels,
+            objects: FixedVec::new(),
+            texel_size: positive(texel_size, "illumination map texel_size")?,
+            trim: DEFAULT_TRIM,
+            used: 0,
+            stats: MapStats::default(),
+        })
+    }
+
+    /// A plane's rectangle leaves out up to the fraction `trim ∈ [0, 0.25]` of its
+    /// photons beyond each of its four sides (outliers: photons scattered far away),
+    /// measured on a 256-bin histogram of the photons' bounding rectangle and rounded
+    /// outwards to a bin. `0` keeps every photon.
+    pub fn with_trim(mut self, trim: f32) -> Result<Self, Error> {
+        self.trim = crate::error::in_range(trim, 0.0, 0.25, "illumination map trim")?;
+        Ok(self)
+    }
+
+    /// Texel side, scene units.
+    pub fn texel_size(&self) -> f32 {
+        self.texel_size
+    }
+
+    /// What the last build did.
+    pub fn stats(&self) -> MapStats {
+        self.stats
+    }
+
+    /// Texels laid out by the last build.
+    pub fn texels_used(&self) -> usize {
+        self.used
+    }
+
+    /// The forward pass of `settings` with `seed` (pass 0), run two or three times
+    /// (layout, plane trim if any, splat) and splatted without storing a photon: the
+    /// memory is the maps' alone. Splats exactly the photons [`shoot`](super::shoot)
+    /// would store, in the same order.
+    pub fn build<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+    ) -> Result<(ForwardStats, MapStats), Error> {
+        let mut forward = ForwardStats::default();
+        let stats = self.build_with(scene, |f| {
+            forward = for_each_photon(scene, settings, seed, 0, |p| f(p));
+            forward.power_unit
+        })?;
+        Ok((forward, stats))
+    }
+
+    /// Builds the maps from stored photons whose powers are in units of `unit` W.
+    pub fn build_from_photons<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        photons: &[Photon],
+        unit: f32,
+    ) -> Result<MapStats, Error> {
+        self.build_with(scene, |f| {
+            photons.iter().for_each(|p| f(p));
+            unit
+        })
+    }
+
+    /// Builds the maps from a photon source that `replay` runs in full, in the same
+    /// order every time, and that returns the power unit (W) of the photons.
+    pub fn build_with<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        mut replay: impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
+    ) -> Result<MapStats, Error> {
+        self.objects.clear();
+        self.used = 0;
+        self.stats = MapStats::default();
+        for (i, o) in scene.objects().iter().enumerate() {
+            if !o.material.stores_photons() {
+                continue;
+            }
+            let map = ObjectMap {
+                shape: o.shape,
+                object: i,
+                grids: [NO_GRID; 6],
+                charts: 0,
+                photons: 0,
+                lo: [f32::INFINITY; 2],
+                hi: [f32::NEG_INFINITY; 2],
+            };
+            self.objects.push(map).map_err(|_| Error::Capacity {
+                what: "illumination map objects",
+                requested: OBJECTS + 1,
+                capacity: OBJECTS,
+            })?;
+        }
+
+        // Pass 1: which objects receive photons, and the planes' photon rectangles.
+        replay(&mut |p: &Photon| {
+            if let Some((k, at)) = self.find(p.position(), None) {
+                if at.normal.dot(p.direction().get()) < 0.0 {
+                    let m = &mut self.objects[k];
+                    m.photons += 1;
+                    for a in 0..2 {
+                        let x = [at.u, at.v][a];
+                        m.lo[a] = m.lo[a].min(x);
+                        m.hi[a] = m.hi[a].max(x);
+                    }
+                }
+            }
+        });
+
+        // Pass 2 per plane: trim the outliers off its rectangle.
+        if self.trim > 0.0 {
+            for k in 0..self.objects.len() {
+                let m = self.objects[k];
+                if matches!(m.shape, Shape::Plane(_)) && m.photons > 0 {
+                    let (lo, hi) = self.trimmed(k, &mut replay);
+                    self.objects[k].lo = lo;
+                    self.objects[k].hi = hi;
+                }
+            }
+        }
+
+        // Layout.
+        let s = self.texel_size;
+        let mut total: u64 = 0;
+        for m in self.objects.iter_mut() {
+            if m.photons == 0 {
+                continue;
+            }
+            let n = match m.shape {
+                Shape::Plane(_) => {
+                    let side = |a: usize| libm::ceilf((m.hi[a] - m.lo[a]) / s).max(1.0);
+                    let (w, h) = (side(0), side(1));
+                    if !(w <= u32::MAX as f32 && h <= u32::MAX as f32) {
+                        return Err(Error::Capacity {
+                            what: "illumination map texels",
+                            requested: usize::MAX,
+                            capacity: usize::MAX,
+                        });
+                    }
+                    m.grids[0] = Grid {
+                        offset: 0,
+                        w: w as u32,
+                        h: h as u32,
+                        u0: m.lo[0],
+                        du: s,
+                        v0: m.lo[1],
+                        dv: s,
+                        periodic_u: false,
+                        profile: Profile::Flat(1.0),
+                    };
+                    1
+                }
+                _ => bounded_grids(&m.shape, s, &mut m.grids).unwrap_or(0),
+            };
+            for g in &mut m.grids[..n] {
+                g.offset = total.min(u32::MAX as u64) as u32;
+                total += g.w as u64 * g.h as u64;
+            }
+            m.charts = n as u8;
+            self.stats.mapped_objects += 1;
+        }
+        if total > u32::MAX as u64 {
+            return Err(Error::Capacity {
+                what: "illumination map texels",
+                requested: total.min(usize::MAX as u64) as usize,
+                capacity: u32::MAX as usize,
+            });
+        }
+        let total = total as usize;
+        self.texels.reserve(total)?;
+        self.used = total;
+        self.stats.texels = total;
+        self.texels.texels_mut()[..total].fill(Rgb::ZERO);
+
+        // Pass 3: splat, in units of the photon power unit.
+        let mut splatted = Rgb::ZERO;
+        let mut dropped = Rgb::ZERO;
+        let (mut n_in, mut n_out) = (0u64, 0u64);
+        let unit = replay(&mut |p: &Photon| {
+            if self.splat(p.position(), p.direction(), p.power()) {
+                splatted += p.power();
+                n_in += 1;
+            } else {
+                dropped += p.power();
+                n_out += 1;
+            }
+        });
+        self.stats.splatted = splatted * unit;
+        self.stats.dropped = dropped * unit;
+        self.stats.splatted_photons = n_in;
+        self.stats.dropped_photons = n_out;
+        self.finish(unit);
+        Ok(self.stats)
+    }
+
+    /// The rectangle of plane `k` without the outlying `trim` of its photons per side.
+    fn trimmed(
+        &self,
+        k: usize,
+        replay: &mut impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
+    ) -> ([f32; 2], [f32; 2]) {
+        let m = self.objects[k];
+        let mut hist = [[0u32; TRIM_BINS]; 2];
+        let width = [m.hi[0] - m.lo[0], m.hi[1] - m.lo[1]];
+        replay(&mut |p: &Photon| {
+            if let Some((j, at)) = self.find(p.position(), None) {
+                if j == k && at.normal.dot(p.direction().get()) < 0.0 {
+                    for a in 0..2 {
+                        let x = [at.u, at.v][a];
+                        let f = if width[a] > 0.0 {
+                            (x - m.lo[a]) / width[a]
+                        } else {
+                            0.0
+                        };
+                        let bin = ((f * TRIM_BINS as f32) as usize).min(TRIM_BINS - 1);
+                        hist[a][bin] += 1;
+                    }
+                }
+            }
+        });
+        let cut = (self.trim as f64 * m.photons as f64) as u32;
+        let (mut lo, mut hi) = (m.lo, m.hi);
+        for a in 0..2 {
+            let bin = width[a] / TRIM_BINS as f32;
+            let (mut first, mut seen) = (0, 0u32);
+            while first < TRIM_BINS - 1 && seen + hist[a][first] <= cut {
+                seen += hist[a][first];
+                first += 1;
+            }
+            let (mut last, mut seen) = (TRIM_BINS - 1, 0u32);
+            while last > first && seen + hist[a][last] <= cut {
+                seen += hist[a][last];
+                last -= 1;
+            }
+            lo[a] = m.lo[a] + first as f32 * bin;
+            hi[a] = if last == TRIM_BINS - 1 {
+                m.hi[a]
+            } else {
+                m.lo[a] + (last + 1) as f32 * bin
+            };
+        }
+        (lo, hi)
+    }
+
+    /// The mapped object (slot) nearest to `x` within tolerance, and where `x` lies on it.
+    #[inline]
+    fn find(&self, x: Vec3, n: Option<UnitVec3>) -> Option<(usize, Located)> {
+        let tol = 1e-4 * max_abs(x).max(1.0);
+        let mut best: Option<(usize, f32)> = None;
+        for (k, m) in self.objects.iter().enumerate() {
+            let d = distance(&m.shape, x);
+            if d <= tol && best.is_none_or(|(_, bd)| d < bd) {
+                best = Some((k, d));
+            }
+        }
+        let (k, _) = best?;
+        Some((k, locate(&self.objects[k].shape, x, n)))
+    }
+
+    /// Splats `power` (any unit) arriving at `x` along `dir` into the four texels
+    /// around it: first between the two texel rows around it, then along each row.
+    /// `false` (nothing splatted) when it arrived from behind, or lies on no chart.
+    fn splat(&mut self, x: Vec3, dir: UnitVec3, power: Rgb) -> bool {
+        let Some((k, at)) = self.find(x, None) else {
+            return false;
+        };
+        if !(at.normal.dot(dir.get()) < 0.0) {
+            return false; // arrived from behind the surface
+        }
+        let m = &self.objects[k];
+        if at.chart >= m.charts as usize {
+            return false;
+        }
+        let g = m.grids[at.chart];
+        let (s, t) = g.st(at.u, at.v);
+        if matches!(m.shape, Shape::Plane(_))
+            && !(s >= 0.0 && t >= 0.0 && s <= g.w as f32 && t <= g.h as f32)
+        {
+            return false; // outside the plane's (trimmed) rectangle
+        }
+        let (i0, i1, fx) = pair(s, g.w, g.periodic_u);
+        let (j0, j1, fy) = pair(t, g.h, false);
+        let texels = self.texels.texels_mut();
+        let base = g.offset as usize;
+        let w = g.w as usize;
+        // The two points on the parallel lines (rows j0 and j1) ...
+        for (j, e) in [(j0, power * (1.0 - fy)), (j1, power * fy)] {
+            // ... then between the two texels of each line.
+            texels[base + j * w + i0] += e * (1.0 - fx);
+            texels[base + j * w + i1] += e * fx;
+        }
+        true
+    }
+
+    /// Turns splatted energy (in units of `unit` W) into irradiance: each texel divided
+    /// by the true area it represents.
+    fn finish(&mut self, unit: f32) {
+        let texels = self.texels.texels_mut();
+        for m in &self.objects {
+            for g in &m.grids[..m.charts as usize] {
+                for j in 0..g.h as usize {
+                    let area = g.texel_area(j);
+                    let scale = if area > 0.0 {
+                        (unit as f64 / area) as f32
+                    } else {
+                        0.0
+                    };
+                    let row = g.offset as usize + j * g.w as usize;
+                    for t in &mut texels[row..row + g.w as usize] {
+                        *t = *t * scale;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The reconstructed irradiance at `x` (W/m²), zero off the maps or behind.
+    #[inline]
+    fn lookup(&self, x: Vec3, n: UnitVec3) -> Rgb {
+        let Some((k, at)) = self.find(x, Some(n)) else {
+            return Rgb::ZERO;
+        };
+        if !(n.dot(at.normal) > 0.0) {
+            return Rgb::ZERO;
+        }
+        let m = &self.objects[k];
+        if at.chart >= m.charts as usize {
+            return Rgb::ZERO;
+        }
+        let g = &m.grids[at.chart];
+        let (s, t) = g.st(at.u, at.v);
+        if matches!(m.shape, Shape::Plane(_))
+            && !(s >= 0.0 && t >= 0.0 && s <= g.w as f32 && t <= g.h as f32)
+        {
+            return Rgb::ZERO;
+        }
+        let (i0, i1, fx) = pair(s, g.w, g.periodic_u);
+        let (j0, j1, fy) = pair(t, g.h, false);
+        let texels = self.texels.texels();
+        let base = g.offset as usize;
+        let w = g.w as usize;
+        let row =
+            |j: usize| texels[base + j * w + i0] * (1.0 - fx) + texels[base + j * w + i1] * fx;
+        row(j0) * (1.0 - fy) + row(j1) * fy
+    }
+
+    /// The slot of scene object `object`, if it is mapped.
+    fn slot(&self, object: usize) -> Option<&ObjectMap> {
+        self.objects
+            .iter()
+            .find(|m| m.object == object && m.charts > 0)
+    }
+
+    /// `(width, height)` in texels of chart `chart` of scene object `object`.
+    pub fn chart_size(&self, object: usize, chart: usize) -> Option<(u32, u32)> {
+        let m = self.slot(object)?;
+        (chart < m.charts as usize).then(|| (m.grids[chart].w, m.grids[chart].h))
+    }
+
+    /// Number of charts laid out for scene object `object` (0 when unmapped).
+    pub fn charts(&self, object: usize) -> usize {
+        self.slot(object).map_or(0, |m| m.charts as usize)
+    }
+
+    /// Sum of the true texel areas of chart `chart` of scene object `object`.
+    pub fn chart_area(&self, object: usize, chart: usize) -> Option<f64> {
+        let m = self.slot(object)?;
+        let g = m.grids.get(chart).filter(|_| chart < m.charts as usize)?;
+        Some(
+            (0..g.h as usize)
+                .map(|j| g.texel_area(j) * g.w as f64)
+                .sum(),
+        )
+    }
+
+    /// Total energy in the maps (W): `Σ E·area` over every texel. Equals
+    /// [`MapStats::splatted`] up to rounding.
+    pub fn total_energy(&self) -> [f64; 3] {
+        let texels = self.texels.texels();
+        let mut sum = [0.0f64; 3];
+        for m in &self.objects {
+            for g in &m.grids[..m.charts as usize] {
+                for j in 0..g.h as usize {
+                    let area = g.texel_area(j);
+                    let row = g.offset as usize + j * g.w as usize;
+                    for t in &texels[row..row + g.w as usize] {
+                        for (s, c) in sum.iter_mut().zip(t.to_array()) {
+                            *s += c as f64 * area;
+                        }
+                    }
+                }
+            }
+        }
+        sum
+    }
+
+    /// The irradiance texels of chart `chart` of scene object `object`, row-major
+    /// (`width × height`, row `j` at `v = v0 + (j + ½)·dv`).
+    pub fn chart_texels(&self, object: usize, chart: usize) -> Option<&[Rgb]> {
+        let m = self.slot(object)?;
+        let g = m.grids.get(chart).filter(|_| chart < m.charts as usize)?;
+        let o = g.offset as usize;
+        Some(&self.texels.texels()[o..o + g.len()])
+    }
+}
+
+/// The default plane trim: one photon in ten thousand per side.
+pub const DEFAULT_TRIM: f32 = 1e-4;
+
+impl<S: TexelStorage, const OBJECTS: usize> CausticStore for IlluminationMaps<S, OBJECTS> {
+    /// The bilinear reconstruction of the irradiance map at `x`.
+    #[inline]
+    fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
+        self.lookup(x, n)
+    }
+
+    /// Paper eq. 8 with every photon taken to arrive along the normal (`l = n`; the
+    /// maps keep no direction): `π·E·kernel(n, n, to_eye)`.
+    #[inline]
+    fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
+        let e = self.lookup(x, n);
+        if e.is_black() {
+            return Rgb::ZERO;
+        }
+        m.kernel(n, n, to_eye) * e * PI
+    }
+}
+
+/// The forward pass of [`shoot`](super::shoot), handing each photon it would store to
+/// `f` instead of writing it to an array: the same photons, in the same order, with
+/// the same power unit. Needs no photon memory at all.
+pub fn for_each_photon<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    mut f: impl FnMut(&Photon),
+) -> ForwardStats {
+    let mut stats = ForwardStats::default();
+    if settings.count == 0 || !(scene.has_caustic_objects() || settings.store_direct) {
+        return stats;
+    }
+    let full_sphere = settings.full_sphere || settings.store_direct;
+    let plan = |light| Emission::<O>::plan(scene, light, settings.count, full_sphere);
+    let unit = scene
+        .lights()
+        .iter()
+        .map(|l| plan(l).nominal_power(l))
+        .fold(0.0, f32::max);
+    if !(unit > 0.0 && unit.is_finite()) {
+        return stats;
+    }
+    stats.power_unit = unit;
+    let inv_unit = 1.0 / unit;
+    for (l, light) in scene.lights().iter().enumerate() {
+        if light.intensity().is_black() {
+            continue;
+        }
+        let emission = plan(light);
+        let key = hash(&[seed, pass as u64, l as u64]);
+        let shift = (unit_f32(key as u32), unit_f32((key >> 32) as u32));
+        let n = emission.count();
+        for i in 0..n {
+            let (dir, power) = emission.photon(light, i, shift);
+            let mut rng = Pcg32::new(hash(&[seed, pass as u64, l as u64, i as u64]));
+            let ray = Ray::new(light.position(), dir);
+            if let Some(hit) = trace::trace(
+                scene,
+                ray,
+                power,
+                settings.max_depth,
+                settings.store_direct,
+                &mut rng,
+            ) {
+                f(&Photon::new(hit.pos, hit.dir, hit.power * inv_unit));
+                stats.stored += 1;
+            }
+        }
+        stats.emitted += n as u64;
+    }
+    stats
+}
