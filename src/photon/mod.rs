@@ -11,11 +11,15 @@
 
 mod emit;
 mod estimate;
+mod illumination;
 pub mod kdtree;
 mod packed;
 mod trace;
 
 pub use estimate::{ConeFilter, KdStore};
+pub use illumination::{
+    for_each_photon, FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
+};
 pub use kdtree::{balance, KdTree, Neighbor};
 pub use packed::Photon;
 
