@@ -250,7 +250,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         unit: f32,
     ) -> Result<MapStats, Error> {
         self.build_with(scene, |f| {
-            photons.iter().for_each(|p| f(p));
+            photons.iter().for_each(&mut *f);
             unit
         })
     }
