@@ -53,12 +53,12 @@ fn main() {
         let queries: Vec<Vec3> = (0..2000)
             .map(|_| Vec3::new(4.0 * g.next_f32() - 2.0, 0.0, 4.0 * g.next_f32() - 2.0))
             .collect();
-        let mut out = [Neighbor::default(); 64];
+        let mut out: heapless::Vec<Neighbor, 64> = heapless::Vec::new();
         let mut times = Vec::new();
         for _ in 0..5 {
             let t = Instant::now();
             for &q in &queries {
-                black_box(tree.k_nearest(q, f32::INFINITY, &mut out));
+                black_box(tree.k_nearest(q, f32::INFINITY, 64, &mut out));
             }
             times.push(t.elapsed().as_secs_f64() / queries.len() as f64);
         }

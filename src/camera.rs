@@ -113,7 +113,10 @@ impl Camera {
         let v = (1.0 - 2.0 * (y as f32 + fy) / self.height as f32) * self.half_h;
         let d = self.forward + self.right * u + self.up * v;
         // |d| ≥ 1 because forward is unit and orthogonal to right and up.
-        Ray::new(self.position, UnitVec3::new_unchecked(d.normalize()))
+        Ray::new(
+            self.position,
+            UnitVec3::new(d).unwrap_or(UnitVec3::new_unchecked(self.forward)),
+        )
     }
 }
 

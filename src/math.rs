@@ -9,6 +9,67 @@ use core::ops::{Add, AddAssign, Mul, MulAssign, Neg};
 use crate::error::{finite, Error};
 pub use glam::{Mat3, Vec3};
 
+/// The correctly rounded square root (IEEE 754 requires it of every implementation, so
+/// all give the same bits). On ARM with a hardware FPU it is the `vsqrt.f32`
+/// instruction — `libm::sqrtf` compiles to ~76 software instructions there — elsewhere
+/// `libm::sqrtf`.
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        vfp::sqrt(x)
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+/// The hardware square root of hard-float ARM targets, the one place the crate uses
+/// `unsafe`: a leaf function of two instructions in assembly. Under the hard-float ABI
+/// (eabihf) the argument and the result travel in `s0`; `.fpu` lets the assembler accept
+/// `vsqrt` whatever FPU the target names (every eabihf core has at least this one).
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+mod vfp {
+    core::arch::global_asm!(
+        ".syntax unified",
+        ".section .text.caustic_vsqrt,\"ax\",%progbits",
+        ".global caustic_vsqrt",
+        ".type caustic_vsqrt,%function",
+        ".thumb",
+        ".thumb_func",
+        ".fpu fpv4-sp-d16",
+        "caustic_vsqrt:",
+        "vsqrt.f32 s0, s0",
+        "bx lr",
+        ".size caustic_vsqrt, . - caustic_vsqrt",
+    );
+
+    extern "C" {
+        fn caustic_vsqrt(x: f32) -> f32;
+    }
+
+    /// `vsqrt.f32`: IEEE 754 correctly rounded, like `libm::sqrtf`.
+    #[inline]
+    pub(super) fn sqrt(x: f32) -> f32 {
+        // SAFETY: `caustic_vsqrt` reads s0, writes s0 and returns; it touches no memory
+        // and follows the AAPCS-VFP convention that `extern "C"` uses on eabihf.
+        unsafe { caustic_vsqrt(x) }
+    }
+}
+
+/// `a` if it is larger than `b`, else `b`: a plain comparison, which unlike `f32::max`
+/// is not a library call on Armv7E-M. (With a NaN `a` it returns `b`.)
+#[inline]
+pub fn max(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
 /// A direction of unit length.
 ///
 /// # Guarantees
@@ -32,7 +93,7 @@ impl UnitVec3 {
         if !(len2.is_finite() && len2 > 0.0) {
             return None;
         }
-        let u = v * (1.0 / libm::sqrtf(len2));
+        let u = v * (1.0 / sqrt(len2));
         u.is_finite().then_some(Self(u))
     }
 

@@ -242,10 +242,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
         let shadow = Ray::spawn(hit, l);
         count.shadow += 1;
-        if self
-            .scene
-            .occluded(&shadow, (light.position() - shadow.origin).length())
-        {
+        if self.scene.occluded(
+            &shadow,
+            crate::math::sqrt((light.position() - shadow.origin).length_squared()),
+        ) {
             return None;
         }
         Some((l, light.intensity() * (1.0 / d2)))

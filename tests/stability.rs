@@ -1049,7 +1049,6 @@ fn zero_photons_within_the_gather_radius() {
 /// Every photon at one point: the k-th nearest distance is 0 there. The estimate must
 /// stay finite (see docs/stability.md: `photon::estimate` divides by π·r² with r = 0).
 #[test]
-#[ignore = "bug in src/photon/estimate.rs (not owned here): r = 0 gives ∞/NaN; see docs/stability.md"]
 fn all_photons_at_one_point() {
     let mut photons = vec![Photon::new(Vec3::ZERO, -UnitVec3::Y, Rgb::ONE); 200];
     photon::balance(&mut photons);

@@ -515,7 +515,13 @@ fn default_radius(scene: &DesktopScene) -> f32 {
     if r > 0.0 {
         r / 40.0
     } else {
-        0.01 * scene.camera().position().length().max(1.0)
+        // Scales with the scene: a hundredth of the camera's distance from the origin.
+        let d = scene.camera().position().length();
+        if d > 0.0 {
+            0.01 * d
+        } else {
+            0.01
+        }
     }
 }
 

@@ -101,13 +101,22 @@ impl<'a, const K: usize> KdStore<'a, K> {
         };
         let (r2, norm) = match self.k {
             Some(k) => {
-                let mut buf = [Neighbor::default(); K];
-                let found = self.tree.k_nearest(x, self.max_radius2, &mut buf[..k]);
-                let (inv_kr, norm) = filter(found.radius2);
-                for nb in &buf[..found.count] {
+                let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
+                let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
+                // Photon positions are known to about ε·|x|, and no estimate resolves
+                // detail below 10⁻⁴ of the gather radius: k photons all at the query
+                // point would otherwise divide by r² = 0. Floor r² there.
+                let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
+                let floor = crate::math::max(
+                    crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
+                    f32::MIN_POSITIVE,
+                );
+                let r2 = crate::math::max(found.radius2, floor);
+                let (inv_kr, norm) = filter(r2);
+                for nb in &buf {
                     add(nb.index as usize, nb.dist2, inv_kr);
                 }
-                (found.radius2, norm)
+                (r2, norm)
             }
             None => {
                 let r2 = self.max_radius2;

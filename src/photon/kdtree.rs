@@ -211,37 +211,47 @@ impl<'a> KdTree<'a> {
         }
     }
 
-    /// The `out.len()` nearest photons to `x` closer than `sqrt(max_radius2)`, as a
-    /// max-heap on distance in `out[..count]` (the farthest first).
-    pub fn k_nearest(&self, x: Vec3, max_radius2: f32, out: &mut [Neighbor]) -> Found {
-        let k = out.len();
+    /// The `k` nearest photons to `x` closer than `sqrt(max_radius2)` (`k` at most the
+    /// capacity `K`), as a max-heap on distance in `out` (the farthest first). `out` is
+    /// the caller's fixed-capacity buffer; it is cleared first, and its storage is never
+    /// zeroed (on a microcontroller that would cost as much as the search).
+    pub fn k_nearest<const K: usize>(
+        &self,
+        x: Vec3,
+        max_radius2: f32,
+        k: usize,
+        out: &mut heapless::Vec<Neighbor, K>,
+    ) -> Found {
+        out.clear();
+        let k = k.min(K);
         if k == 0 {
             return Found {
                 count: 0,
                 radius2: max_radius2,
             };
         }
-        let mut count = 0usize;
         self.search(x, max_radius2, |index, dist2| {
             let nb = Neighbor {
                 dist2,
                 index: index as u32,
             };
-            if count < k {
-                out[count] = nb;
-                count += 1;
-                sift_up(&mut out[..count], count - 1);
-                if count == k {
+            if out.len() < k {
+                // Cannot fail: len < k ≤ K.
+                let _ = out.push(nb);
+                let last = out.len() - 1;
+                sift_up(out, last);
+                if out.len() == k {
                     return out[0].dist2;
                 }
                 max_radius2
             } else {
                 // The search only offers photons closer than out[0].
                 out[0] = nb;
-                sift_down(&mut out[..k], 0);
+                sift_down(out, 0);
                 out[0].dist2
             }
         });
+        let count = out.len();
         let radius2 = if count == k {
             out[0].dist2
         } else {
@@ -367,8 +377,8 @@ mod tests {
             let x = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 12.0 - Vec3::ONE;
             let k = [1, 2, 7, 32][q % 4];
             let r2 = [0.5f32, 4.0, 1e9][q % 3];
-            let mut out = std::vec![Neighbor::default(); k];
-            let found = tree.k_nearest(x, r2, &mut out);
+            let mut out: heapless::Vec<Neighbor, 32> = heapless::Vec::new();
+            let found = tree.k_nearest(x, r2, k, &mut out);
             let mut got: Vec<f32> = out[..found.count].iter().map(|n| n.dist2).collect();
             got.sort_by(f32::total_cmp);
             let want = brute_k_nearest(photons, x, r2, k);

@@ -81,7 +81,7 @@ impl PhotonSettings {
                 value: 0.0,
             });
         }
-        positive(max_radius, "photons.max_radius")?;
+        gather_radius(max_radius)?;
         in_range(max_depth as f32, 0.0, 255.0, "photons.max_depth")?;
         Ok(Self {
             count,
@@ -130,7 +130,7 @@ impl PhotonSettings {
 
     /// A copy with another maximum radius (progressive passes shrink it).
     pub fn with_max_radius(mut self, max_radius: f32) -> Result<Self, Error> {
-        self.max_radius = positive(max_radius, "photons.max_radius")?;
+        self.max_radius = gather_radius(max_radius)?;
         Ok(self)
     }
 
@@ -153,6 +153,23 @@ impl PhotonSettings {
     /// The cone filter, if any.
     pub fn cone_filter(&self) -> Option<ConeFilter> {
         self.cone
+    }
+}
+
+/// A gather radius whose square is a normal, finite `f32` (the estimate divides by
+/// `π r²`): positive, at least about 1.1e-19 and at most about 1.8e19.
+fn gather_radius(r: f32) -> Result<f32, Error> {
+    positive(r, "photons.max_radius")?;
+    let r2 = r * r;
+    if r2 >= f32::MIN_POSITIVE && r2.is_finite() {
+        Ok(r)
+    } else {
+        Err(Error::OutOfRange {
+            what: "photons.max_radius",
+            value: r,
+            min: 1.1e-19,
+            max: 1.8e19,
+        })
     }
 }
 
