@@ -236,6 +236,22 @@ pub struct LoadedScene {
     pub passes: u32,
     /// Radius shrink exponent for passes (default 2/3).
     pub alpha: f32,
+    /// The caustic store (`photons.caustic_store`), default the kd-tree.
+    pub caustic_store: StoreChoice,
+}
+
+/// Which caustic store renders the caustics (`photons.caustic_store`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum StoreChoice {
+    /// `{ "type": "kd_tree" }`: the photon kd-tree and its k-nearest estimate (default).
+    #[default]
+    KdTree,
+    /// `{ "type": "illumination_map", "texel_size": s }`: Arvo's illumination maps with
+    /// texels of side `s` scene units (the paper's "scale").
+    IlluminationMap {
+        /// World length of a texel's side, > 0.
+        texel_size: f32,
+    },
 }
 
 /// Default photons per light.
@@ -487,10 +503,30 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             format!("must lie in (0, 1) (got {alpha})"),
         ));
     }
+    let mut caustic_store = StoreChoice::KdTree;
     if let Some(store) = &p.caustic_store {
-        match type_of(store, "photons.caustic_store", &["kd_tree"])? {
+        let path = "photons.caustic_store";
+        match type_of(store, path, &["kd_tree", "illumination_map"])? {
             "kd_tree" if store.as_object().is_some_and(|o| o.len() == 1) => {}
-            _ => return Err(err("photons.caustic_store", "kd_tree takes no other field")),
+            "kd_tree" => return Err(err(path, "kd_tree takes no other field")),
+            _ => {
+                let o = store.as_object().ok_or_else(|| err(path, "expected an object"))?;
+                if let Some(k) = o.keys().find(|k| *k != "type" && *k != "texel_size") {
+                    return Err(err(
+                        format!("{path}.{k}"),
+                        "unknown field (illumination_map takes texel_size)",
+                    ));
+                }
+                let t = o
+                    .get("texel_size")
+                    .ok_or_else(|| err(format!("{path}.texel_size"), "missing field `texel_size`"))?
+                    .as_f64()
+                    .filter(|t| t.is_finite() && *t > 0.0 && (*t as f32) > 0.0)
+                    .ok_or_else(|| err(format!("{path}.texel_size"), "must be a positive number"))?;
+                caustic_store = StoreChoice::IlluminationMap {
+                    texel_size: t as f32,
+                };
+            }
         }
     }
     Ok(LoadedScene {
@@ -498,6 +534,7 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
         photons,
         passes,
         alpha,
+        caustic_store,
     })
 }
 
