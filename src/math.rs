@@ -70,6 +70,20 @@ pub fn max(a: f32, b: f32) -> f32 {
     }
 }
 
+/// `x` limited to `[lo, hi]` by comparisons: unlike `f32::clamp`, no panic path (which
+/// on a device pulls kilobytes of float formatting into flash) when the bounds are not
+/// constants. A NaN `x` comes back unchanged.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x < lo {
+        lo
+    } else if x > hi {
+        hi
+    } else {
+        x
+    }
+}
+
 /// A direction of unit length.
 ///
 /// # Guarantees

@@ -140,7 +140,9 @@ impl Cylinder {
         let rel = p - self.base;
         let z = self.axis.dot(rel);
         let point = if normal.dot(self.axis.get()).abs() < 0.5 {
-            self.base + self.axis.get() * z.clamp(0.0, self.height) + normal.get() * self.radius
+            self.base
+                + self.axis.get() * crate::math::clamp(z, 0.0, self.height)
+                + normal.get() * self.radius
         } else {
             let zc = if normal.dot(self.axis.get()) > 0.0 {
                 self.height
