@@ -510,7 +510,9 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             "kd_tree" if store.as_object().is_some_and(|o| o.len() == 1) => {}
             "kd_tree" => return Err(err(path, "kd_tree takes no other field")),
             _ => {
-                let o = store.as_object().ok_or_else(|| err(path, "expected an object"))?;
+                let o = store
+                    .as_object()
+                    .ok_or_else(|| err(path, "expected an object"))?;
                 if let Some(k) = o.keys().find(|k| *k != "type" && *k != "texel_size") {
                     return Err(err(
                         format!("{path}.{k}"),
@@ -522,7 +524,9 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
                     .ok_or_else(|| err(format!("{path}.texel_size"), "missing field `texel_size`"))?
                     .as_f64()
                     .filter(|t| t.is_finite() && *t > 0.0 && (*t as f32) > 0.0)
-                    .ok_or_else(|| err(format!("{path}.texel_size"), "must be a positive number"))?;
+                    .ok_or_else(|| {
+                        err(format!("{path}.texel_size"), "must be a positive number")
+                    })?;
                 caustic_store = StoreChoice::IlluminationMap {
                     texel_size: t as f32,
                 };
