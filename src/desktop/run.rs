@@ -323,3 +323,67 @@ impl Progress {
         }
     }
 }
+
+/// Renders `scene` with Arvo's illumination maps (texels of side `texel_size` scene
+/// units) as the caustic store instead of the kd-tree: one forward pass into a photon
+/// array (timed as `emit_ms`), splatted into maps sized by the layout (timed as
+/// `balance_ms`, the store's build), then the backward pass. One pass only: the maps
+/// have no radius to shrink. Also returns what the map build did.
+pub fn render_illumination(
+    scene: &DesktopScene,
+    settings: &PhotonSettings,
+    opts: &RenderOptions,
+    texel_size: f32,
+) -> Result<(Image, RenderStats, photon::MapStats), Error> {
+    if opts.passes > 1 {
+        return Err(Error::Capacity {
+            what: "progressive passes with illumination maps",
+            requested: opts.passes as usize,
+            capacity: 1,
+        });
+    }
+    let cam = scene.camera();
+    let (w, h) = (cam.width(), cam.height());
+    let threads = opts.threads.max(1);
+    let mut stats = RenderStats {
+        width: w,
+        height: h,
+        threads,
+        passes: 1,
+        ..RenderStats::default()
+    };
+    let needed = photons_needed(scene, settings);
+    if needed > MAX_PHOTONS {
+        return Err(Error::Capacity {
+            what: "photons (count × lights)",
+            requested: needed,
+            capacity: MAX_PHOTONS,
+        });
+    }
+    let t = Instant::now();
+    let mut photons = vec![Photon::ZERO; needed];
+    let f = photon::shoot(scene, settings, opts.seed, 0, &mut photons)?;
+    stats.emit_ms += ms(t.elapsed());
+    stats.photons_emitted = f.emitted;
+    stats.photons_stored = f.stored as u64;
+    let t = Instant::now();
+    let mut maps: photon::IlluminationMaps<vec::Vec<Rgb>, { super::MAX_OBJECTS }> =
+        photon::IlluminationMaps::new(vec::Vec::new(), texel_size)?;
+    let map_stats = maps.build_from_photons(scene, &photons[..f.stored], f.power_unit)?;
+    drop(photons);
+    stats.balance_ms += ms(t.elapsed());
+    let progress = Progress::new(opts.progress && std::io::stderr().is_terminal(), h as usize);
+    let timed = Timed {
+        inner: &maps,
+        nanos: AtomicU64::new(0),
+    };
+    let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
+        Renderer::new(scene, &timed, settings.max_depth())?.with_supersample(opts.supersample)?;
+    let mut image = Image::new(w, h);
+    let t = Instant::now();
+    stats.rays = render_rows(&renderer, &mut image, threads, &progress);
+    stats.render_ms += ms(t.elapsed());
+    stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
+    progress.finish();
+    Ok((image, stats, map_stats))
+}
