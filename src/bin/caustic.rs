@@ -4,7 +4,9 @@
 //! caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
 //!                [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
 //!                [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-//!                [--exposure E] [--supersample S] [--stats] [--quiet]
+//!                [--exposure E] [--supersample S] [--emit cones|sphere]
+//!                [--stats] [--quiet]
+//!                [--store kd|illum] [--texel-size S]
 //! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]
 //! ```
 //! Exit status: 0 on success, 2 on bad input (scene, flags, files), 1 otherwise.
@@ -14,15 +16,19 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use caustic::desktop::image::{compare, mask_above, Image};
+use caustic::desktop::run::render_illumination;
+use caustic::desktop::scene_file::StoreChoice;
 use caustic::desktop::{load_scene, render, RenderOptions, RenderStats};
-use caustic::photon::{ConeFilter, PhotonSettings};
+use caustic::photon::{ConeFilter, MapStats, PhotonSettings};
 use caustic::raster::ToneMap;
 
 const USAGE: &str = "usage:
   caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
                  [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
                  [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-                 [--exposure E] [--supersample S] [--stats] [--quiet]
+                 [--exposure E] [--supersample S] [--emit cones|sphere]
+                 [--stats] [--quiet]
+                 [--store kd|illum] [--texel-size S]
   caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]";
 
 /// A failure and its exit status.
@@ -131,6 +137,9 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     let threads: Option<usize> = f.value(&["--threads"])?;
     let exposure: f32 = f.value(&["--exposure"])?.unwrap_or(1.0);
     let supersample: u32 = f.value(&["--supersample"])?.unwrap_or(1);
+    let emit: Option<String> = f.value(&["--emit"])?;
+    let store: Option<String> = f.value(&["--store"])?;
+    let texel_size: Option<f32> = f.value(&["--texel-size"])?;
     let want_stats = f.switch("--stats");
     let quiet = f.switch("--quiet");
     let pos = f.positional()?;
@@ -167,7 +176,12 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
         }
         None => None,
     };
-    let settings = settings.with_cone_filter(cone);
+    let full_sphere = match emit.as_deref() {
+        None | Some("cones") => false,
+        Some("sphere") => true,
+        Some(other) => return Err(bad_input(format!("--emit takes cones or sphere, not {other}"))),
+    };
+    let settings = settings.with_cone_filter(cone).with_full_sphere(full_sphere);
     let alpha = alpha.unwrap_or(loaded.alpha);
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(bad_input("--alpha must lie in (0, 1)"));
@@ -183,7 +197,28 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
         supersample,
     };
     let parse_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let (image, stats) = render(&scene, &settings, &opts).map_err(|e| bad_input(e.to_string()))?;
+    // The caustic store: --store, else the scene file's; illumination maps take
+    // --texel-size, else the file's texel_size, else 0.05.
+    let file_texel = match loaded.caustic_store {
+        StoreChoice::IlluminationMap { texel_size } => Some(texel_size),
+        StoreChoice::KdTree => None,
+    };
+    let illum = match store.as_deref() {
+        Some("kd") => None,
+        Some("illum") => Some(texel_size.or(file_texel).unwrap_or(0.05)),
+        Some(other) => return Err(bad_input(format!("--store: \"{other}\" (kd or illum)"))),
+        None => file_texel.map(|t| texel_size.unwrap_or(t)),
+    };
+    if illum.is_none() && texel_size.is_some() {
+        return Err(bad_input("--texel-size needs --store illum"));
+    }
+    let (image, stats, map_stats) = match illum {
+        None => render(&scene, &settings, &opts).map(|(i, s)| (i, s, None)),
+        Some(t) => {
+            render_illumination(&scene, &settings, &opts, t).map(|(i, s, m)| (i, s, Some((t, m))))
+        }
+    }
+    .map_err(|e| bad_input(e.to_string()))?;
     let t_write = Instant::now();
     if let Some(path) = &out {
         image.write_png(path, &tone).map_err(|e| Failure {
@@ -201,10 +236,35 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     if want_stats {
         println!(
             "{}",
-            stats_json(&stats, parse_ms, write_ms, t0.elapsed().as_secs_f64() * 1e3)
+            illum_json(
+                stats_json(&stats, parse_ms, write_ms, t0.elapsed().as_secs_f64() * 1e3),
+                map_stats
+            )
         );
     }
     Ok(())
+}
+
+/// Adds `"store"` (and the illumination maps' texels and dropped photons) to the stats.
+fn illum_json(mut json: String, maps: Option<(f32, MapStats)>) -> String {
+    json.pop(); // the closing brace
+    match maps {
+        None => json += ",\"store\":\"kd\"}",
+        Some((t, m)) => {
+            json += &format!(
+                concat!(
+                    ",\"store\":\"illum\",\"illumination\":{{\"texel_size\":{},\"texels\":{},",
+                    "\"bytes\":{},\"objects\":{},\"dropped_photons\":{}}}}}"
+                ),
+                t,
+                m.texels,
+                m.texels * std::mem::size_of::<caustic::math::Rgb>(),
+                m.mapped_objects,
+                m.dropped_photons
+            )
+        }
+    }
+    json
 }
 
 fn stats_json(s: &RenderStats, parse_ms: f64, write_ms: f64, total_ms: f64) -> String {
