@@ -202,8 +202,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// A plane's rectangle leaves out up to the fraction `trim ∈ [0, 0.25]` of its
     /// photons beyond each of its four sides (outliers: photons scattered far away),
-    /// measured on a 256-bin histogram of the photons' bounding rectangle and rounded
-    /// outwards to a bin. `0` keeps every photon.
+    /// located by histograms and rounded outwards (see `trimmed`). `0` keeps every
+    /// photon; the default is [`DEFAULT_TRIM`].
     pub fn with_trim(mut self, trim: f32) -> Result<Self, Error> {
         self.trim = crate::error::in_range(trim, 0.0, 0.25, "illumination map trim")?;
         Ok(self)
@@ -386,52 +386,70 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         Ok(self.stats)
     }
 
-    /// The rectangle of plane `k` without the outlying `trim` of its photons per side.
+    /// The rectangle of plane `k` without the outlying `trim` of its photons beyond each
+    /// side: each of the four bounds is a quantile, bracketed by two rounds of 256-bin
+    /// histograms (the second inside the bin the first found; 65 536 steps across the
+    /// photons' bounding rectangle) and rounded outwards to the final bin.
     fn trimmed(
         &self,
         k: usize,
         replay: &mut impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
     ) -> ([f32; 2], [f32; 2]) {
         let m = self.objects[k];
-        let mut hist = [[0u32; TRIM_BINS]; 2];
-        let width = [m.hi[0] - m.lo[0], m.hi[1] - m.lo[1]];
-        replay(&mut |p: &Photon| {
-            if let Some((j, at)) = self.find(p.position(), None) {
-                if j == k && at.normal.dot(p.direction().get()) < 0.0 {
-                    for a in 0..2 {
-                        let x = [at.u, at.v][a];
-                        let f = if width[a] > 0.0 {
-                            (x - m.lo[a]) / width[a]
-                        } else {
-                            0.0
-                        };
-                        let bin = ((f * TRIM_BINS as f32) as usize).min(TRIM_BINS - 1);
-                        hist[a][bin] += 1;
+        let cut = (self.trim as f64 * m.photons as f64) as u32;
+        // Per axis and side (0: lower, 1: upper): the bracket and the photons beyond it.
+        let mut bracket = [[(m.lo[0], m.hi[0]); 2], [(m.lo[1], m.hi[1]); 2]];
+        let mut beyond = [[0u32; 2]; 2];
+        for _round in 0..2 {
+            let mut hist = [[[0u32; TRIM_BINS]; 2]; 2];
+            replay(&mut |p: &Photon| {
+                if let Some((j, at)) = self.find(p.position(), None) {
+                    if j == k && at.normal.dot(p.direction().get()) < 0.0 {
+                        for a in 0..2 {
+                            let x = [at.u, at.v][a];
+                            for side in 0..2 {
+                                let (b0, b1) = bracket[a][side];
+                                if x >= b0 && x <= b1 && b1 > b0 {
+                                    let f = (x - b0) / (b1 - b0) * TRIM_BINS as f32;
+                                    hist[a][side][(f as usize).min(TRIM_BINS - 1)] += 1;
+                                }
+                            }
+                        }
                     }
                 }
+            });
+            for a in 0..2 {
+                for side in 0..2 {
+                    let (b0, b1) = bracket[a][side];
+                    if !(b1 > b0) {
+                        continue;
+                    }
+                    let h = &hist[a][side];
+                    let bin = (b1 - b0) / TRIM_BINS as f32;
+                    let mut seen = beyond[a][side];
+                    let order = |i: usize| if side == 0 { i } else { TRIM_BINS - 1 - i };
+                    let mut found = TRIM_BINS - 1;
+                    for i in 0..TRIM_BINS {
+                        if seen + h[order(i)] > cut {
+                            found = i;
+                            break;
+                        }
+                        seen += h[order(i)];
+                    }
+                    let b = order(found);
+                    beyond[a][side] = seen;
+                    let lo = b0 + b as f32 * bin;
+                    let hi = if b == TRIM_BINS - 1 {
+                        b1
+                    } else {
+                        b0 + (b + 1) as f32 * bin
+                    };
+                    bracket[a][side] = (lo, hi);
+                }
             }
-        });
-        let cut = (self.trim as f64 * m.photons as f64) as u32;
-        let (mut lo, mut hi) = (m.lo, m.hi);
-        for a in 0..2 {
-            let bin = width[a] / TRIM_BINS as f32;
-            let (mut first, mut seen) = (0, 0u32);
-            while first < TRIM_BINS - 1 && seen + hist[a][first] <= cut {
-                seen += hist[a][first];
-                first += 1;
-            }
-            let (mut last, mut seen) = (TRIM_BINS - 1, 0u32);
-            while last > first && seen + hist[a][last] <= cut {
-                seen += hist[a][last];
-                last -= 1;
-            }
-            lo[a] = m.lo[a] + first as f32 * bin;
-            hi[a] = if last == TRIM_BINS - 1 {
-                m.hi[a]
-            } else {
-                m.lo[a] + (last + 1) as f32 * bin
-            };
         }
+        let lo = [bracket[0][0].0, bracket[1][0].0];
+        let hi = [bracket[0][1].1.max(lo[0]), bracket[1][1].1.max(lo[1])];
         (lo, hi)
     }
 
@@ -597,8 +615,9 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
     }
 }
 
-/// The default plane trim: one photon in ten thousand per side.
-pub const DEFAULT_TRIM: f32 = 1e-4;
+/// The default plane trim: at most 0.5% of a plane's photons beyond each side of its
+/// rectangle (the faint, far halo of photons scattered off glass).
+pub const DEFAULT_TRIM: f32 = 0.005;
 
 impl<S: TexelStorage, const OBJECTS: usize> CausticStore for IlluminationMaps<S, OBJECTS> {
     /// The bilinear reconstruction of the irradiance map at `x`.
