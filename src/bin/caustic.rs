@@ -179,9 +179,15 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     let full_sphere = match emit.as_deref() {
         None | Some("cones") => false,
         Some("sphere") => true,
-        Some(other) => return Err(bad_input(format!("--emit takes cones or sphere, not {other}"))),
+        Some(other) => {
+            return Err(bad_input(format!(
+                "--emit takes cones or sphere, not {other}"
+            )))
+        }
     };
-    let settings = settings.with_cone_filter(cone).with_full_sphere(full_sphere);
+    let settings = settings
+        .with_cone_filter(cone)
+        .with_full_sphere(full_sphere);
     let alpha = alpha.unwrap_or(loaded.alpha);
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(bad_input("--alpha must lie in (0, 1)"));
