@@ -238,3 +238,25 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
     let mut small = vec![Photon::ZERO; 10];
     assert!(photon::shoot(&scene, &s, 0, 0, &mut small).is_err());
 }
+
+/// The desktop's parallel forward pass stores exactly the core's photons, in the same
+/// order, on any number of threads (so the tree and the image cannot depend on them).
+#[test]
+fn the_parallel_forward_pass_is_the_serial_one() {
+    use caustic::desktop::run::{PhotonBuffer, RenderStats};
+    let text = std::fs::read_to_string(format!(
+        "{}/scenes/two_balls.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let scene = parse_scene(&text).unwrap().scene;
+    let s = PhotonSettings::new(30_000, 16, 0.1, 8).unwrap();
+    let (serial, unit, _) = photons(&scene, &s, 9);
+    for threads in [1, 3] {
+        let mut buf = PhotonBuffer::for_budget(&scene, &s).unwrap();
+        buf.fill(&scene, &s, 9, 0, threads, &mut RenderStats::default())
+            .unwrap();
+        assert_eq!(buf.unit(), unit);
+        assert_eq!(buf.tree().photons(), &serial[..], "{threads} threads");
+    }
+}

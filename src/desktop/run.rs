@@ -14,8 +14,11 @@ use super::image::Image;
 use super::{DesktopScene, MAX_DEPTH, MAX_GATHER, MAX_PHOTONS};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::photon::{self, balance, photons_needed, CausticStore, KdTree, Photon, PhotonSettings};
+use crate::photon::{
+    self, balance, photons_needed, CausticStore, Emitter, KdTree, Photon, PhotonSettings,
+};
 use crate::render::{RayCount, Renderer};
+use crate::scene::Scene;
 use crate::Error;
 
 /// How to render on the desktop.
@@ -116,10 +119,18 @@ pub struct PhotonBuffer {
     unit: f32,
 }
 
+/// Photons traced per work item of the parallel forward pass. Fixed, so that the order
+/// of the stored photons — and so the tree and the image — does not depend on the
+/// number of threads.
+const CHUNK: u32 = 4096;
+
 impl PhotonBuffer {
     /// Room for one forward pass of `settings` over `scene`; an error beyond
     /// [`MAX_PHOTONS`].
-    pub fn for_budget(scene: &DesktopScene, settings: &PhotonSettings) -> Result<Self, Error> {
+    pub fn for_budget<const O: usize, const L: usize>(
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+    ) -> Result<Self, Error> {
         let needed = photons_needed(scene, settings);
         if needed > MAX_PHOTONS {
             return Err(Error::Capacity {
@@ -135,26 +146,69 @@ impl PhotonBuffer {
         })
     }
 
-    /// Runs forward pass `pass` into the buffer and balances it, adding the times and
-    /// counts to `stats`.
-    pub fn fill(
+    /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
+    /// adding the times and counts to `stats`. The photons are traced in chunks of
+    /// [`CHUNK`] and kept in emission order: the same array as the core's
+    /// [`photon::shoot`], whatever the thread count.
+    pub fn fill<const O: usize, const L: usize>(
         &mut self,
-        scene: &DesktopScene,
+        scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
         pass: u32,
+        threads: usize,
         stats: &mut RenderStats,
     ) -> Result<(), Error> {
+        let needed = photons_needed(scene, settings);
+        if needed > self.photons.len() {
+            return Err(Error::Capacity {
+                what: "photons (count × lights)",
+                requested: needed,
+                capacity: self.photons.len(),
+            });
+        }
         let t = Instant::now();
-        let f = photon::shoot(scene, settings, seed, pass, &mut self.photons)?;
+        let emitter = Emitter::new(scene, settings, seed, pass);
+        let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())
+            .flat_map(|l| {
+                let n = emitter.count(l);
+                (0..n)
+                    .step_by(CHUNK as usize)
+                    .map(move |s| (l, s, (s + CHUNK).min(n)))
+            })
+            .collect();
+        let results: vec::Vec<Mutex<vec::Vec<Photon>>> =
+            items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
+        let next = AtomicUsize::new(0);
+        std::thread::scope(|scope| {
+            for _ in 0..threads.clamp(1, items.len().max(1)) {
+                scope.spawn(|| loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(l, start, end)) = items.get(k) else {
+                        break;
+                    };
+                    let local: vec::Vec<Photon> =
+                        (start..end).filter_map(|i| emitter.photon(l, i)).collect();
+                    if let Ok(mut slot) = results[k].lock() {
+                        *slot = local;
+                    }
+                });
+            }
+        });
+        let mut stored = 0;
+        for r in results {
+            let chunk = r.into_inner().unwrap_or_default();
+            self.photons[stored..stored + chunk.len()].copy_from_slice(&chunk);
+            stored += chunk.len();
+        }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
-        balance(&mut self.photons[..f.stored]);
+        balance(&mut self.photons[..stored]);
         stats.balance_ms += ms(t.elapsed());
-        stats.photons_emitted += f.emitted;
-        stats.photons_stored += f.stored as u64;
-        self.len = f.stored;
-        self.unit = f.power_unit;
+        stats.photons_emitted += emitter.emitted();
+        stats.photons_stored += stored as u64;
+        self.len = stored;
+        self.unit = emitter.power_unit();
         Ok(())
     }
 
@@ -200,7 +254,7 @@ pub fn render(
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
         let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
-        photons.fill(scene, &pass_settings, opts.seed, pass, &mut stats)?;
+        photons.fill(scene, &pass_settings, opts.seed, pass, threads, &mut stats)?;
         let store =
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
         let timed = Timed {

@@ -57,13 +57,11 @@ use core::f32::consts::PI;
 use heapless::Vec as FixedVec;
 
 use self::chart::{bounded_grids, distance, locate, pair, Grid, Located, Profile};
-use super::emit::Emission;
-use super::{trace, CausticStore, ForwardStats, Photon, PhotonSettings};
+use super::{for_each_photon, CausticStore, ForwardStats, Photon, PhotonSettings};
 use crate::error::{positive, Error};
-use crate::geometry::{Ray, Shape};
+use crate::geometry::Shape;
 use crate::material::Classic;
 use crate::math::{max_abs, Rgb, UnitVec3, Vec3};
-use crate::sampling::{hash, unit_f32, Pcg32};
 use crate::scene::Scene;
 
 /// Where the texels live: a fixed array on the device, a `Vec` on the desktop.
@@ -636,59 +634,4 @@ impl<S: TexelStorage, const OBJECTS: usize> CausticStore for IlluminationMaps<S,
         }
         m.kernel(n, n, to_eye) * e * PI
     }
-}
-
-/// The forward pass of [`shoot`](super::shoot), handing each photon it would store to
-/// `f` instead of writing it to an array: the same photons, in the same order, with
-/// the same power unit. Needs no photon memory at all.
-pub fn for_each_photon<const O: usize, const L: usize>(
-    scene: &Scene<O, L>,
-    settings: &PhotonSettings,
-    seed: u64,
-    pass: u32,
-    mut f: impl FnMut(&Photon),
-) -> ForwardStats {
-    let mut stats = ForwardStats::default();
-    if settings.count == 0 || !(scene.has_caustic_objects() || settings.store_direct) {
-        return stats;
-    }
-    let full_sphere = settings.full_sphere || settings.store_direct;
-    let plan = |light| Emission::<O>::plan(scene, light, settings.count, full_sphere);
-    let unit = scene
-        .lights()
-        .iter()
-        .map(|l| plan(l).nominal_power(l))
-        .fold(0.0, f32::max);
-    if !(unit > 0.0 && unit.is_finite()) {
-        return stats;
-    }
-    stats.power_unit = unit;
-    let inv_unit = 1.0 / unit;
-    for (l, light) in scene.lights().iter().enumerate() {
-        if light.intensity().is_black() {
-            continue;
-        }
-        let emission = plan(light);
-        let key = hash(&[seed, pass as u64, l as u64]);
-        let shift = (unit_f32(key as u32), unit_f32((key >> 32) as u32));
-        let n = emission.count();
-        for i in 0..n {
-            let (dir, power) = emission.photon(light, i, shift);
-            let mut rng = Pcg32::new(hash(&[seed, pass as u64, l as u64, i as u64]));
-            let ray = Ray::new(light.position(), dir);
-            if let Some(hit) = trace::trace(
-                scene,
-                ray,
-                power,
-                settings.max_depth,
-                settings.store_direct,
-                &mut rng,
-            ) {
-                f(&Photon::new(hit.pos, hit.dir, hit.power * inv_unit));
-                stats.stored += 1;
-            }
-        }
-        stats.emitted += n as u64;
-    }
-    stats
 }

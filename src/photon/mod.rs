@@ -18,7 +18,7 @@ mod trace;
 
 pub use estimate::{ConeFilter, KdStore};
 pub use illumination::{
-    for_each_photon, FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
+    FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
 pub use kdtree::{balance, KdTree, Neighbor};
 pub use packed::Photon;
@@ -193,16 +193,126 @@ pub fn photons_needed<const O: usize, const L: usize>(
     settings.count as usize * scene.lights().len()
 }
 
-/// The forward pass: shoots `settings.count` photons from each light and stores those
-/// that land on a diffuse surface after a specular bounce, in emission order, into
-/// `out[..stored]` (not yet balanced).
+/// One forward pass, photon by photon: photon `i` of light `l` is a pure function of
+/// `(scene, settings, seed, pass, l, i)`, so a pass can be split among threads in any
+/// way and still store the same photons.
 ///
-/// Photon `i` of light `l` in pass `pass` draws its directions from a Hammersley set
+/// Photon `i` of light `l` in pass `pass` draws its direction from a Hammersley set
 /// shifted by `hash(seed, pass, l)` and its random choices from a PCG32 stream keyed by
-/// `hash(seed, pass, l, i)`: a pure function of `(scene, settings, seed, pass)`.
-///
-/// A scene with no mirror, glass or reflective/transparent classic object does no work.
-/// An error when `out` cannot hold `count × lights` photons.
+/// `hash(seed, pass, l, i)`. A scene with no mirror, glass or reflective/transparent
+/// classic object emits nothing, and so does a dark light.
+#[derive(Clone, Debug)]
+pub struct Emitter<'a, const O: usize, const L: usize> {
+    scene: &'a Scene<O, L>,
+    settings: PhotonSettings,
+    seed: u64,
+    pass: u32,
+    /// Per light: its emission plan and the point set's shift.
+    plans: heapless::Vec<(Emission<O>, (f32, f32)), L>,
+    unit: f32,
+}
+
+impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
+    /// The emission plans of pass `pass` of `scene`'s lights.
+    pub fn new(scene: &'a Scene<O, L>, settings: &PhotonSettings, seed: u64, pass: u32) -> Self {
+        let active = settings.count > 0 && (scene.has_caustic_objects() || settings.store_direct);
+        let full_sphere = settings.full_sphere || settings.store_direct;
+        let mut plans = heapless::Vec::new();
+        let mut unit = 0.0f32;
+        for (l, light) in scene.lights().iter().enumerate() {
+            let count = if active && !light.intensity().is_black() {
+                settings.count
+            } else {
+                0
+            };
+            let plan = Emission::<O>::plan(scene, light, count, full_sphere);
+            if count > 0 {
+                unit = unit.max(plan.nominal_power(light));
+            }
+            let key = hash(&[seed, pass as u64, l as u64]);
+            // Cannot overflow: one plan per light, at most L lights.
+            let _ = plans.push((plan, (unit_f32(key as u32), unit_f32((key >> 32) as u32))));
+        }
+        if !(unit > 0.0 && unit.is_finite()) {
+            plans.clear(); // nothing to emit
+            unit = 0.0;
+        }
+        Self {
+            scene,
+            settings: *settings,
+            seed,
+            pass,
+            plans,
+            unit,
+        }
+    }
+
+    /// Power of one unit of stored photon power, W (0 when nothing is emitted).
+    pub fn power_unit(&self) -> f32 {
+        self.unit
+    }
+
+    /// Photons light `l` emits (0 for a dark light or when nothing is emitted).
+    pub fn count(&self, l: usize) -> u32 {
+        self.plans.get(l).map_or(0, |p| p.0.count())
+    }
+
+    /// Photons emitted by all lights.
+    pub fn emitted(&self) -> u64 {
+        (0..self.plans.len()).map(|l| self.count(l) as u64).sum()
+    }
+
+    /// Traces photon `i` of light `l` (`i < count(l)`): where it is stored, if anywhere.
+    pub fn photon(&self, l: usize, i: u32) -> Option<Photon> {
+        let (emission, shift) = self.plans.get(l)?;
+        let light = &self.scene.lights()[l];
+        let (dir, power) = emission.photon(light, i, *shift);
+        let mut rng = Pcg32::new(hash(&[self.seed, self.pass as u64, l as u64, i as u64]));
+        let ray = Ray::new(light.position(), dir);
+        let s = &self.settings;
+        let hit = trace::trace(
+            self.scene,
+            ray,
+            power,
+            s.max_depth,
+            s.store_direct,
+            &mut rng,
+        )?;
+        Some(Photon::new(hit.pos, hit.dir, hit.power * (1.0 / self.unit)))
+    }
+}
+
+/// The forward pass of [`shoot`], handing each photon it would store to `f` instead of
+/// writing it to an array: the same photons, in the same order, with the same power
+/// unit. Needs no photon memory at all (the illumination maps splat as they go).
+pub fn for_each_photon<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    mut f: impl FnMut(&Photon),
+) -> ForwardStats {
+    let emitter = Emitter::new(scene, settings, seed, pass);
+    let mut stats = ForwardStats {
+        emitted: emitter.emitted(),
+        stored: 0,
+        power_unit: emitter.power_unit(),
+    };
+    for l in 0..scene.lights().len() {
+        for i in 0..emitter.count(l) {
+            if let Some(p) = emitter.photon(l, i) {
+                f(&p);
+                stats.stored += 1;
+            }
+        }
+    }
+    stats
+}
+
+/// The forward pass: shoots `settings.count` photons from each light (see [`Emitter`])
+/// and stores those that land on a diffuse surface after a specular bounce, in
+/// emission order, into `out[..stored]` (not yet balanced). An error when `out` cannot
+/// hold `count × lights` photons.
 pub fn shoot<const O: usize, const L: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
@@ -218,48 +328,11 @@ pub fn shoot<const O: usize, const L: usize>(
             capacity: out.len(),
         });
     }
-    let mut stats = ForwardStats::default();
-    if settings.count == 0 || !(scene.has_caustic_objects() || settings.store_direct) {
-        return Ok(stats);
-    }
-    let full_sphere = settings.full_sphere || settings.store_direct;
-    let plan = |light| Emission::<O>::plan(scene, light, settings.count, full_sphere);
-    let unit = scene
-        .lights()
-        .iter()
-        .map(|l| plan(l).nominal_power(l))
-        .fold(0.0, f32::max);
-    if !(unit > 0.0 && unit.is_finite()) {
-        return Ok(stats); // every light is dark
-    }
-    stats.power_unit = unit;
-    let inv_unit = 1.0 / unit;
-    for (l, light) in scene.lights().iter().enumerate() {
-        if light.intensity().is_black() {
-            continue;
-        }
-        let emission = plan(light);
-        let key = hash(&[seed, pass as u64, l as u64]);
-        let shift = (unit_f32(key as u32), unit_f32((key >> 32) as u32));
-        let n = emission.count();
-        for i in 0..n {
-            let (dir, power) = emission.photon(light, i, shift);
-            let mut rng = Pcg32::new(hash(&[seed, pass as u64, l as u64, i as u64]));
-            let ray = Ray::new(light.position(), dir);
-            if let Some(hit) = trace::trace(
-                scene,
-                ray,
-                power,
-                settings.max_depth,
-                settings.store_direct,
-                &mut rng,
-            ) {
-                out[stats.stored] = Photon::new(hit.pos, hit.dir, hit.power * inv_unit);
-                stats.stored += 1;
-            }
-        }
-        stats.emitted += n as u64;
-    }
+    let mut n = 0;
+    let stats = for_each_photon(scene, settings, seed, pass, |p| {
+        out[n] = *p;
+        n += 1;
+    });
     Ok(stats)
 }
 
