@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use caustic::desktop::image::{compare, mask_above, Image};
+use caustic::desktop::run::render_illumination;
 use caustic::desktop::{parse_scene, render, RenderOptions};
 use caustic::photon::PhotonSettings;
 use plotters::prelude::*;
@@ -31,8 +32,20 @@ struct Config {
     k: u32,
     passes: u32,
     supersample: u32,
-    /// Progressive: every photon within r_i, r_1 = max_radius / 5.
-    fixed: bool,
+    estimator: Estimator,
+}
+
+/// How the caustic light is estimated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Estimator {
+    /// The k nearest photons within the scene's `max_radius`.
+    Nearest,
+    /// Every photon within `r = (max_radius/5)·(N/10⁵)^(−1/6)` — the MSE-optimal
+    /// scaling of a fixed kernel (bias ∝ r², variance ∝ 1/(N r²)) — shrinking further
+    /// with the passes as `r_i² = r_1²·i^(α−1)`.
+    FixedRadius,
+    /// Illumination maps with texels of side `max_radius/5`.
+    IlluminationMap,
 }
 
 /// One measured point.
@@ -57,9 +70,22 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// The sweep: single passes over photon budgets and k, then progressive passes.
+/// The sweep: single passes over photon budgets for each estimator and k, then
+/// progressive passes.
 fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     let mut out = Vec::new();
+    let mut add = |series: String, photons: u32, k: u32, passes: u32, estimator: Estimator| {
+        out.push((
+            series,
+            Config {
+                photons,
+                k,
+                passes,
+                supersample,
+                estimator,
+            },
+        ));
+    };
     let budgets: &[u32] = if quick {
         &[10_000, 100_000]
     } else {
@@ -68,17 +94,42 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     let ks: &[u32] = if quick { &[64] } else { &[16, 64, 256] };
     for &k in ks {
         for &photons in budgets {
-            out.push((
+            add(
                 format!("kd-tree, k = {k}"),
-                Config {
-                    photons,
-                    k,
-                    passes: 1,
-                    supersample,
-                    fixed: false,
-                },
-            ));
+                photons,
+                k,
+                1,
+                Estimator::Nearest,
+            );
         }
+    }
+    let budgets: &[u32] = if quick {
+        &[100_000]
+    } else {
+        &[30_000, 100_000, 300_000, 1_000_000, 3_000_000]
+    };
+    for &photons in budgets {
+        add(
+            "kd-tree, fixed radius".into(),
+            photons,
+            64,
+            1,
+            Estimator::FixedRadius,
+        );
+    }
+    let budgets: &[u32] = if quick {
+        &[100_000]
+    } else {
+        &[10_000, 30_000, 100_000, 300_000, 1_000_000]
+    };
+    for &photons in budgets {
+        add(
+            "illumination maps".into(),
+            photons,
+            64,
+            1,
+            Estimator::IlluminationMap,
+        );
     }
     let passes: &[u32] = if quick {
         &[1, 4]
@@ -86,16 +137,13 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
         &[1, 2, 4, 8, 16, 32]
     };
     for &p in passes {
-        out.push((
+        add(
             "progressive, 100k/pass".into(),
-            Config {
-                photons: 100_000,
-                k: 64,
-                passes: p,
-                supersample,
-                fixed: true,
-            },
-        ));
+            100_000,
+            64,
+            p,
+            Estimator::FixedRadius,
+        );
     }
     out
 }
@@ -126,14 +174,15 @@ fn measure(
     let p = loaded.photons;
     let mut points = Vec::new();
     for (series, c) in configs(quick, supersample) {
-        let radius = if c.fixed {
-            p.max_radius() / 5.0
-        } else {
-            p.max_radius()
+        let r1 = p.max_radius() / 5.0;
+        let radius = match c.estimator {
+            Estimator::Nearest => p.max_radius(),
+            Estimator::FixedRadius => r1 * (c.photons as f32 / 1e5).powf(-1.0 / 6.0),
+            Estimator::IlluminationMap => r1,
         };
         let settings = PhotonSettings::new(c.photons, c.k, radius, p.max_depth())
             .unwrap()
-            .with_fixed_radius(c.fixed);
+            .with_fixed_radius(c.estimator == Estimator::FixedRadius);
         let opts = RenderOptions {
             passes: c.passes,
             supersample: c.supersample,
@@ -143,7 +192,12 @@ fn measure(
         let mut image = None;
         for _ in 0..repeats {
             let t = Instant::now();
-            let (img, _) = render(&scene, &settings, &opts).unwrap();
+            let img = match c.estimator {
+                Estimator::IlluminationMap => {
+                    render_illumination(&scene, &settings, &opts, r1).unwrap().0
+                }
+                _ => render(&scene, &settings, &opts).unwrap().0,
+            };
             times.push(t.elapsed().as_secs_f64());
             image = Some(img);
         }
@@ -249,6 +303,8 @@ fn plot(points: &[Point], out: &Path) -> Result<(), Box<dyn std::error::Error>> 
             )?;
         chart
             .configure_mesh()
+            .y_label_formatter(&|v| format!("{v:.3}"))
+            .x_label_formatter(&|v| format!("{v:.3}"))
             .x_desc("wall time, s (median)")
             .y_desc("relative RMSE")
             .draw()?;

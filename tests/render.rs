@@ -398,6 +398,11 @@ fn every_scene_error_names_its_path_and_problem() {
             "[0, 255]",
         ),
         (
+            Box::new(|v| v["photons"]["gather"] = json!("knn")),
+            "photons.gather",
+            "unknown gather \"knn\"",
+        ),
+        (
             Box::new(|v| v["photons"]["passes"] = json!(0)),
             "photons.passes",
             "at least 1",

@@ -4,7 +4,7 @@
 //! caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
 //!                [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
 //!                [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-//!                [--exposure E] [--supersample S] [--emit cones|sphere]
+//!                [--exposure E] [--supersample S] [--emit cones|sphere] [--gather nearest|radius]
 //!                [--stats] [--quiet]
 //!                [--store kd|illum] [--texel-size S]
 //! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]
@@ -26,7 +26,7 @@ const USAGE: &str = "usage:
   caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
                  [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
                  [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-                 [--exposure E] [--supersample S] [--emit cones|sphere]
+                 [--exposure E] [--supersample S] [--emit cones|sphere] [--gather nearest|radius]
                  [--stats] [--quiet]
                  [--store kd|illum] [--texel-size S]
   caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]";
@@ -138,6 +138,7 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     let exposure: f32 = f.value(&["--exposure"])?.unwrap_or(1.0);
     let supersample: u32 = f.value(&["--supersample"])?.unwrap_or(1);
     let emit: Option<String> = f.value(&["--emit"])?;
+    let gather: Option<String> = f.value(&["--gather"])?;
     let store: Option<String> = f.value(&["--store"])?;
     let texel_size: Option<f32> = f.value(&["--texel-size"])?;
     let want_stats = f.switch("--stats");
@@ -176,6 +177,16 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
         }
         None => None,
     };
+    let fixed_radius = match gather.as_deref() {
+        None => p.fixed_radius(),
+        Some("nearest") => false,
+        Some("radius") => true,
+        Some(other) => {
+            return Err(bad_input(format!(
+                "--gather takes nearest or radius, not {other}"
+            )))
+        }
+    };
     let full_sphere = match emit.as_deref() {
         None | Some("cones") => false,
         Some("sphere") => true,
@@ -187,7 +198,8 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     };
     let settings = settings
         .with_cone_filter(cone)
-        .with_full_sphere(full_sphere);
+        .with_full_sphere(full_sphere)
+        .with_fixed_radius(fixed_radius);
     let alpha = alpha.unwrap_or(loaded.alpha);
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(bad_input("--alpha must lie in (0, 1)"));

@@ -130,6 +130,9 @@ pub struct PhotonsDef {
     pub alpha: Option<f32>,
     /// Which caustic store.
     pub caustic_store: Option<Value>,
+    /// How the kd-tree estimate gathers photons: `"nearest"` (the k nearest within
+    /// `max_radius`, the default) or `"radius"` (every photon within `max_radius`).
+    pub gather: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -492,6 +495,16 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             format!("exceeds the path stack capacity {}", super::MAX_DEPTH),
         ));
     }
+    let photons = match p.gather.as_deref() {
+        None | Some("nearest") => photons,
+        Some("radius") => photons.with_fixed_radius(true),
+        Some(other) => {
+            return Err(err(
+                "photons.gather",
+                format!("unknown gather \"{other}\" (expected nearest or radius)"),
+            ));
+        }
+    };
     let passes = p.passes.unwrap_or(1);
     if passes == 0 {
         return Err(err("photons.passes", "must be at least 1"));
