@@ -119,6 +119,23 @@ pub struct PhotonBuffer {
     unit: f32,
 }
 
+/// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
+/// [`MAX_PHOTONS`].
+fn desktop_budget<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+) -> Result<usize, Error> {
+    let needed = photons_needed(scene, settings);
+    if needed > MAX_PHOTONS {
+        return Err(Error::Capacity {
+            what: "photons (count × lights)",
+            requested: needed,
+            capacity: MAX_PHOTONS,
+        });
+    }
+    Ok(needed)
+}
+
 /// Photons traced per work item of the parallel forward pass. Fixed, so that the order
 /// of the stored photons — and so the tree and the image — does not depend on the
 /// number of threads.
@@ -131,14 +148,7 @@ impl PhotonBuffer {
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
     ) -> Result<Self, Error> {
-        let needed = photons_needed(scene, settings);
-        if needed > MAX_PHOTONS {
-            return Err(Error::Capacity {
-                what: "photons (count × lights)",
-                requested: needed,
-                capacity: MAX_PHOTONS,
-            });
-        }
+        let needed = desktop_budget(scene, settings)?;
         Ok(Self {
             photons: vec![Photon::ZERO; needed],
             len: 0,
@@ -406,14 +416,7 @@ pub fn render_illumination(
         passes: 1,
         ..RenderStats::default()
     };
-    let needed = photons_needed(scene, settings);
-    if needed > MAX_PHOTONS {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: MAX_PHOTONS,
-        });
-    }
+    let needed = desktop_budget(scene, settings)?;
     let t = Instant::now();
     let mut photons = vec![Photon::ZERO; needed];
     let f = photon::shoot(scene, settings, opts.seed, 0, &mut photons)?;

@@ -169,12 +169,7 @@ impl Cylinder {
 mod tests {
     use super::*;
 
-    fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
-        Ray::new(
-            Vec3::from_array(o),
-            UnitVec3::new(Vec3::from_array(d)).unwrap(),
-        )
-    }
+    use crate::geometry::tests::ray;
 
     #[test]
     fn side_caps_inside_and_parallel() {

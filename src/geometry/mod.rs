@@ -183,8 +183,16 @@ pub(crate) fn stable_roots(a: f32, b: f32, c: f32, disc: f32) -> Option<(f32, f3
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A ray from `o` along `d` (normalised), for the shapes' tests.
+    pub(crate) fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
+        Ray::new(
+            Vec3::from_array(o),
+            UnitVec3::new(Vec3::from_array(d)).unwrap(),
+        )
+    }
 
     #[test]
     fn stable_roots_match_closed_form_and_survive_cancellation() {

@@ -72,12 +72,7 @@ impl Sphere {
 mod tests {
     use super::*;
 
-    fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
-        Ray::new(
-            Vec3::from_array(o),
-            UnitVec3::new(Vec3::from_array(d)).unwrap(),
-        )
-    }
+    use crate::geometry::tests::ray;
 
     #[test]
     fn outside_inside_behind_tangent_and_grazing() {
