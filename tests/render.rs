@@ -205,6 +205,18 @@ fn images_are_bit_identical_whatever_the_thread_count() {
     }
 }
 
+/// Progressive passes too: the same seed gives the same bits on any number of threads.
+#[test]
+fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
+    let (scene, settings) = small("glass_sphere.json", 48, 36);
+    let one = RenderOptions { threads: 1, seed: 5, passes: 3, ..RenderOptions::default() };
+    let (a, sa) = render(&scene, &settings, &one).unwrap();
+    let (b, _) = render(&scene, &settings, &RenderOptions { threads: 4, ..one }).unwrap();
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(sa.passes, 3);
+    assert_eq!(sa.photons_emitted, 3 * settings.count() as u64);
+}
+
 /// The Fig. 6 scene the device builds in code is the scene in `scenes/fig6.json`.
 #[test]
 fn the_device_scene_is_the_scene_file() {
