@@ -33,20 +33,32 @@ struct Config {
     passes: u32,
     supersample: u32,
     estimator: Estimator,
+    /// Part of the progressive series (radius from `PROGRESSIVE_R1`, even at one pass).
+    series_progressive: bool,
 }
 
 /// How the caustic light is estimated.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Estimator {
-    /// The k nearest photons within the scene's `max_radius`.
+    /// The k nearest photons within [`NEAREST_RADIUS`].
     Nearest,
-    /// Every photon within `r = (max_radius/5)·(N/10⁵)^(−1/6)` — the MSE-optimal
-    /// scaling of a fixed kernel (bias ∝ r², variance ∝ 1/(N r²)) — shrinking further
-    /// with the passes as `r_i² = r_1²·i^(α−1)`.
+    /// Every photon within a fixed radius: [`FIXED_RADIUS`] for single passes (the
+    /// reference's own kernel, so that what remains is noise and transport, not the
+    /// choice of kernel at a caustic's fold); progressive passes start at
+    /// [`PROGRESSIVE_R1`] and shrink as `r_i² = r_1²·i^(α−1)`.
     FixedRadius,
-    /// Illumination maps with texels of side `max_radius/5`.
+    /// Illumination maps with texels of side [`TEXEL`].
     IlluminationMap,
 }
+
+/// The k-nearest estimate's radius bound, scene units (a tenth of the spheres' radius).
+const NEAREST_RADIUS: f32 = 0.1;
+/// The single-pass fixed radius: the reference's kernel radius.
+const FIXED_RADIUS: f32 = 0.015;
+/// The first radius of the progressive passes.
+const PROGRESSIVE_R1: f32 = 0.02;
+/// The illumination maps' texel side.
+const TEXEL: f32 = 0.02;
 
 /// One measured point.
 #[derive(Clone, Debug)]
@@ -75,16 +87,16 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     let mut out = Vec::new();
     let mut add = |series: String, photons: u32, k: u32, passes: u32, estimator: Estimator| {
-        out.push((
-            series,
-            Config {
-                photons,
-                k,
-                passes,
-                supersample,
-                estimator,
-            },
-        ));
+        let series_progressive = series.starts_with("progressive");
+        let c = Config {
+            photons,
+            k,
+            passes,
+            supersample,
+            estimator,
+            series_progressive,
+        };
+        out.push((series, c));
     };
     let budgets: &[u32] = if quick {
         &[10_000, 100_000]
@@ -106,11 +118,11 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     let budgets: &[u32] = if quick {
         &[100_000]
     } else {
-        &[30_000, 100_000, 300_000, 1_000_000, 3_000_000]
+        &[30_000, 100_000, 300_000, 500_000, 1_000_000, 3_000_000]
     };
     for &photons in budgets {
         add(
-            "kd-tree, fixed radius".into(),
+            "kd-tree, fixed radius 0.015".into(),
             photons,
             64,
             1,
@@ -174,11 +186,11 @@ fn measure(
     let p = loaded.photons;
     let mut points = Vec::new();
     for (series, c) in configs(quick, supersample) {
-        let r1 = p.max_radius() / 5.0;
         let radius = match c.estimator {
-            Estimator::Nearest => p.max_radius(),
-            Estimator::FixedRadius => r1 * (c.photons as f32 / 1e5).powf(-1.0 / 6.0),
-            Estimator::IlluminationMap => r1,
+            Estimator::Nearest => NEAREST_RADIUS,
+            Estimator::FixedRadius if c.passes > 1 || c.series_progressive => PROGRESSIVE_R1,
+            Estimator::FixedRadius => FIXED_RADIUS,
+            Estimator::IlluminationMap => TEXEL,
         };
         let settings = PhotonSettings::new(c.photons, c.k, radius, p.max_depth())
             .unwrap()
@@ -194,7 +206,9 @@ fn measure(
             let t = Instant::now();
             let img = match c.estimator {
                 Estimator::IlluminationMap => {
-                    render_illumination(&scene, &settings, &opts, r1).unwrap().0
+                    render_illumination(&scene, &settings, &opts, TEXEL)
+                        .unwrap()
+                        .0
                 }
                 _ => render(&scene, &settings, &opts).unwrap().0,
             };

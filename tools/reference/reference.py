@@ -156,7 +156,7 @@ def parse_scene(js):
         ob["mat"] = mats[o["material"]]
         objs.append(ob)
     ph = js.get("photons", {})
-    _keys(ph, "photons", [], ["count", "k", "max_radius", "max_depth", "passes", "alpha", "caustic_store"])
+    _keys(ph, "photons", [], ["count", "k", "max_radius", "max_depth", "passes", "alpha", "caustic_store", "gather"])
     max_depth = int(ph.get("max_depth", 8))
     return dict(camera=camera, background=bg, lights=lights, objects=objs, max_depth=max_depth)
 
