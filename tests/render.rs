@@ -209,7 +209,12 @@ fn images_are_bit_identical_whatever_the_thread_count() {
 #[test]
 fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
     let (scene, settings) = small("glass_sphere.json", 48, 36);
-    let one = RenderOptions { threads: 1, seed: 5, passes: 3, ..RenderOptions::default() };
+    let one = RenderOptions {
+        threads: 1,
+        seed: 5,
+        passes: 3,
+        ..RenderOptions::default()
+    };
     let (a, sa) = render(&scene, &settings, &one).unwrap();
     let (b, _) = render(&scene, &settings, &RenderOptions { threads: 4, ..one }).unwrap();
     assert_eq!(bits(&a), bits(&b));
