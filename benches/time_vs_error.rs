@@ -204,18 +204,24 @@ fn measure(
         let mut image = None;
         for _ in 0..repeats {
             let t = Instant::now();
-            let img = match c.estimator {
+            let result = match c.estimator {
                 Estimator::IlluminationMap => {
-                    render_illumination(&scene, &settings, &opts, TEXEL)
-                        .unwrap()
-                        .0
+                    render_illumination(&scene, &settings, &opts, TEXEL).map(|r| r.0)
                 }
-                _ => render(&scene, &settings, &opts).unwrap().0,
+                _ => render(&scene, &settings, &opts).map(|r| r.0),
             };
+            match result {
+                Ok(img) => image = Some(img),
+                Err(e) => {
+                    // A budget the store refuses (e.g. too many texels) is a point we
+                    // cannot measure, not a failure of the benchmark.
+                    eprintln!("{name} {series} N={}: skipped: {e}", c.photons);
+                    break;
+                }
+            }
             times.push(t.elapsed().as_secs_f64());
-            image = Some(img);
         }
-        let img = image.unwrap();
+        let Some(img) = image else { continue };
         let img2 = img.binned(2);
         let e = |a: &Image, b: &Image, m: Option<&[bool]>| {
             compare(a, b, m).map_or(f64::NAN, |e| e.rel_rmse)

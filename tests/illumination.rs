@@ -376,3 +376,23 @@ fn photons_from_behind_are_not_splatted() {
     assert_eq!((stats.splatted_photons, stats.dropped_photons), (2, 1));
     assert_eq!(maps.total_energy(), [0.0; 3]);
 }
+
+/// Photons scattered far over an infinite plane with a small texel would need more
+/// texels than the desktop allows: an error that names the texel size, never an
+/// allocation that aborts the process.
+#[test]
+fn a_layout_beyond_the_texel_budget_is_an_error() {
+    let text = std::fs::read_to_string(format!(
+        "{}/scenes/two_balls.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let loaded = caustic::desktop::parse_scene(&text).unwrap();
+    let mut scene = loaded.scene;
+    scene.set_camera(scene.camera().with_size(8, 6).unwrap());
+    let settings = caustic::photon::PhotonSettings::new(100_000, 16, 0.02, 8).unwrap();
+    let opts = caustic::desktop::RenderOptions::default();
+    let e = caustic::desktop::run::render_illumination(&scene, &settings, &opts, 0.02).unwrap_err();
+    assert!(matches!(e, caustic::Error::Capacity { .. }), "{e}");
+    assert!(e.to_string().contains("texel size"), "{e}");
+}

@@ -93,6 +93,10 @@ impl<const N: usize> TexelStorage for [Rgb; N] {
     }
 }
 
+/// Most texels a heap-backed (desktop) map may hold: 2²⁶ texels, 768 MiB.
+#[cfg(feature = "std")]
+pub const MAX_HEAP_TEXELS: usize = 1 << 26;
+
 #[cfg(feature = "std")]
 impl TexelStorage for std::vec::Vec<Rgb> {
     fn texels(&self) -> &[Rgb] {
@@ -101,7 +105,16 @@ impl TexelStorage for std::vec::Vec<Rgb> {
     fn texels_mut(&mut self) -> &mut [Rgb] {
         self
     }
+    /// Grows to `needed` texels, up to [`MAX_HEAP_TEXELS`]: a layout beyond it (a tiny
+    /// texel over photons scattered far) is an error, not an allocation that aborts.
     fn reserve(&mut self, needed: usize) -> Result<(), Error> {
+        if needed > MAX_HEAP_TEXELS {
+            return Err(Error::Capacity {
+                what: "illumination map texels (increase the texel size)",
+                requested: needed,
+                capacity: MAX_HEAP_TEXELS,
+            });
+        }
         self.clear();
         self.resize(needed, Rgb::ZERO);
         self.shrink_to_fit();
