@@ -106,13 +106,7 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     let ks: &[u32] = if quick { &[64] } else { &[16, 64, 256] };
     for &k in ks {
         for &photons in budgets {
-            add(
-                format!("kd-tree, k = {k}"),
-                photons,
-                k,
-                1,
-                Estimator::Nearest,
-            );
+            add(format!("kd-tree k={k}"), photons, k, 1, Estimator::Nearest);
         }
     }
     let budgets: &[u32] = if quick {
@@ -122,7 +116,7 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     };
     for &photons in budgets {
         add(
-            "kd-tree, fixed radius 0.015".into(),
+            "kd-tree fixed r=0.015".into(),
             photons,
             64,
             1,
@@ -150,7 +144,7 @@ fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
     };
     for &p in passes {
         add(
-            "progressive, 100k/pass".into(),
+            "progressive 100k/pass".into(),
             100_000,
             64,
             p,
@@ -399,6 +393,7 @@ fn main() {
             repeats,
         ));
     }
+    // Series and scene names hold no comma, so the CSV needs no quoting.
     let mut csv = String::from("scene,series,photons,k,passes,supersample,seconds,full_rel_rmse,caustic_rel_rmse,full_rel_rmse_bin2,caustic_rel_rmse_bin2\n");
     for p in &points {
         let c = p.config;
