@@ -239,8 +239,8 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
     assert!(photon::shoot(&scene, &s, 0, 0, &mut small).is_err());
 }
 
-/// The desktop's parallel forward pass stores exactly the core's photons, in the same
-/// order, on any number of threads (so the tree and the image cannot depend on them).
+/// The desktop's parallel forward pass and balance give exactly the core's tree, on any
+/// number of threads (so the image cannot depend on them).
 #[test]
 fn the_parallel_forward_pass_is_the_serial_one() {
     use caustic::desktop::run::{PhotonBuffer, RenderStats};
@@ -250,8 +250,10 @@ fn the_parallel_forward_pass_is_the_serial_one() {
     ))
     .unwrap();
     let scene = parse_scene(&text).unwrap().scene;
-    let s = PhotonSettings::new(30_000, 16, 0.1, 8).unwrap();
+    // Enough photons that the balance runs in parallel too (above 2^15 stored).
+    let s = PhotonSettings::new(60_000, 16, 0.1, 8).unwrap();
     let (serial, unit, _) = photons(&scene, &s, 9);
+    assert!(serial.len() > 1 << 15, "{}", serial.len());
     for threads in [1, 3] {
         let mut buf = PhotonBuffer::for_budget(&scene, &s).unwrap();
         buf.fill(&scene, &s, 9, 0, threads, &mut RenderStats::default())

@@ -136,6 +136,48 @@ fn desktop_budget<const O: usize, const L: usize>(
     Ok(needed)
 }
 
+/// Balances the kd-tree on `threads` threads: the top levels on this one, then the
+/// subtrees below them — disjoint ranges of the array — on all, then the permutation
+/// into heap order. The same array as [`balance`], bit for bit.
+fn balance_parallel(photons: &mut [Photon], threads: usize) {
+    // Below this a thread costs more than it saves.
+    const SERIAL: usize = 1 << 15;
+    if threads <= 1 || photons.len() < SERIAL {
+        balance(photons);
+        return;
+    }
+    let n = photons.len();
+    let mut subtrees = vec::Vec::new();
+    // Four subtrees per thread, rounded up to a level: balances the load.
+    let levels = usize::BITS - (4 * threads - 1).leading_zeros();
+    photon::balance_top(photons, levels, |t| subtrees.push(t));
+    subtrees.sort_by_key(|t| t.lo);
+    // Cut the array into the subtrees' disjoint slices.
+    let mut work = vec::Vec::with_capacity(subtrees.len());
+    let mut rest = &mut *photons;
+    let mut at = 0;
+    for t in subtrees {
+        let (_, tail) = rest.split_at_mut(t.lo - at);
+        let (slice, tail) = tail.split_at_mut(t.hi - t.lo);
+        work.push((slice, t));
+        rest = tail;
+        at = t.hi;
+    }
+    let work = Mutex::new(work);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
+                let Some((slice, t)) = next else { break };
+                photon::balance_subtree(slice, n, t);
+            });
+        }
+    });
+    // Every subtree is partitioned, and the slices' borrow of `photons` is over.
+    drop(work);
+    photon::balance_finish(photons);
+}
+
 /// Photons traced per work item of the parallel forward pass. Fixed, so that the order
 /// of the stored photons — and so the tree and the image — does not depend on the
 /// number of threads.
@@ -213,7 +255,7 @@ impl PhotonBuffer {
         }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
-        balance(&mut self.photons[..stored]);
+        balance_parallel(&mut self.photons[..stored], threads);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
         stats.photons_stored += stored as u64;

@@ -48,34 +48,117 @@ pub fn balance(photons: &mut [Photon]) {
     if n == 0 {
         return;
     }
-    partition(photons);
+    partition(photons, n, Subtree::ROOT.with_len(n), u32::MAX, |_| {});
     permute_to_heap(photons);
 }
 
-fn partition(photons: &mut [Photon]) {
+/// A subtree still to be partitioned: heap node `h` (1-based) whose subtree occupies the
+/// in-order positions `lo..hi` of the whole array.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Subtree {
+    /// Heap node of the subtree's root (1-based).
+    pub h: usize,
+    /// First in-order position of the subtree.
+    pub lo: usize,
+    /// One past its last.
+    pub hi: usize,
+}
+
+impl Subtree {
+    const ROOT: Subtree = Subtree { h: 1, lo: 0, hi: 0 };
+
+    fn with_len(self, n: usize) -> Self {
+        Subtree { hi: n, ..self }
+    }
+
+    fn depth(&self) -> u32 {
+        usize::BITS - 1 - self.h.leading_zeros()
+    }
+}
+
+/// The parallel form of [`balance`], in three steps for a caller that has threads
+/// (the core has none): [`balance_top`] partitions the top `levels` levels and hands
+/// out the subtrees below them, which occupy disjoint ranges `lo..hi`; the caller
+/// balances each with [`balance_subtree`] on its own slice, in any order or at once;
+/// [`balance_finish`] puts the whole array in heap order. The result is the array
+/// [`balance`] makes, bit for bit.
+pub fn balance_top(photons: &mut [Photon], levels: u32, pending: impl FnMut(Subtree)) {
     let n = photons.len();
-    // (heap node, lo, hi): the node's subtree occupies photons[lo..hi] in order.
-    let mut stack = [(0usize, 0usize, 0usize); MAX_HEIGHT + 1];
-    stack[0] = (1, 0, n);
+    if n > 0 {
+        partition(photons, n, Subtree::ROOT.with_len(n), levels, pending);
+    }
+}
+
+/// Partitions subtree `t` of an array of `n` photons; `photons` is that array's slice
+/// `t.lo..t.hi`. See [`balance_top`].
+pub fn balance_subtree(photons: &mut [Photon], n: usize, t: Subtree) {
+    debug_assert_eq!(photons.len(), t.hi - t.lo);
+    let base = t.lo;
+    partition_slice(photons, n, base, t, u32::MAX, &mut |_| {});
+}
+
+/// Permutes a fully partitioned array into heap order. See [`balance_top`].
+pub fn balance_finish(photons: &mut [Photon]) {
+    permute_to_heap(photons);
+}
+
+/// Partitions `start` and its descendants down to (not including) depth `stop`, handing
+/// the subtrees at depth `stop` to `pending`. `photons` is the whole array.
+fn partition(
+    photons: &mut [Photon],
+    n: usize,
+    start: Subtree,
+    stop: u32,
+    mut pending: impl FnMut(Subtree),
+) {
+    partition_slice(photons, n, 0, start, stop, &mut pending);
+}
+
+/// As [`partition`], on a slice holding the in-order positions `base..base + len`.
+fn partition_slice(
+    photons: &mut [Photon],
+    n: usize,
+    base: usize,
+    start: Subtree,
+    stop: u32,
+    pending: &mut dyn FnMut(Subtree),
+) {
+    // The subtrees still to do; a subtree occupies photons[lo..hi] in in-order positions.
+    let mut stack = [Subtree::ROOT; MAX_HEIGHT + 1];
+    stack[0] = start;
     let mut sp = 1;
     while sp > 0 {
         sp -= 1;
-        let (h, lo, hi) = stack[sp];
-        let mid = inorder_index(h, n);
-        let range = &mut photons[lo..hi];
+        let t = stack[sp];
+        if t.depth() >= stop {
+            pending(t);
+            continue;
+        }
+        let mid = inorder_index(t.h, n);
+        let range = &mut photons[t.lo - base..t.hi - base];
         let axis = longest_axis(range);
         if range.len() > 1 {
-            range.select_nth_unstable_by(mid - lo, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
+            range
+                .select_nth_unstable_by(mid - t.lo, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
         }
-        photons[mid].flags = (photons[mid].flags & !AXIS_MASK) | axis as u8;
+        let node = &mut photons[mid - base];
+        node.flags = (node.flags & !AXIS_MASK) | axis as u8;
         // Right first, so that the left subtree is processed next: the stack then holds
         // at most one pending right subtree per level.
-        if mid + 1 < hi {
-            stack[sp] = (2 * h + 1, mid + 1, hi);
+        if mid + 1 < t.hi {
+            stack[sp] = Subtree {
+                h: 2 * t.h + 1,
+                lo: mid + 1,
+                hi: t.hi,
+            };
             sp += 1;
         }
-        if lo < mid {
-            stack[sp] = (2 * h, lo, mid);
+        if t.lo < mid {
+            stack[sp] = Subtree {
+                h: 2 * t.h,
+                lo: t.lo,
+                hi: mid,
+            };
             sp += 1;
         }
     }
@@ -397,6 +480,26 @@ mod tests {
                 r2
             });
             assert_eq!(inside, brute_k_nearest(photons, x, r2, usize::MAX).len());
+        }
+    }
+
+    #[test]
+    fn the_step_wise_balance_is_the_balance() {
+        for n in [0usize, 1, 2, 7, 100, 1000, 4097] {
+            let base = random_set(n, 31 + n as u64);
+            let mut whole = base.clone();
+            balance(&mut whole);
+            for levels in [0u32, 1, 3, 20] {
+                let mut parts = base.clone();
+                let mut pending = Vec::new();
+                balance_top(&mut parts, levels, |t| pending.push(t));
+                // Balance the subtrees in reverse order: the order must not matter.
+                for t in pending.iter().rev() {
+                    balance_subtree(&mut parts[t.lo..t.hi], n, *t);
+                }
+                balance_finish(&mut parts);
+                assert_eq!(parts, whole, "n={n} levels={levels}");
+            }
         }
     }
 

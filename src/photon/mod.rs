@@ -20,7 +20,9 @@ pub use estimate::{ConeFilter, KdStore};
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
-pub use kdtree::{balance, KdTree, Neighbor};
+pub use kdtree::{
+    balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
+};
 pub use packed::Photon;
 
 use emit::Emission;
