@@ -309,18 +309,9 @@ pub fn render(
         photons.fill(scene, &pass_settings, opts.seed, pass, threads, &mut stats)?;
         let store =
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
-        let timed = Timed {
-            inner: &store,
-            nanos: AtomicU64::new(0),
-        };
-        let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
-            Renderer::new(scene, &timed, settings.max_depth())?
-                .with_supersample(opts.supersample)?;
-        let t = Instant::now();
-        let rays = render_rows(&renderer, &mut image, threads, &progress);
-        stats.render_ms += ms(t.elapsed());
-        stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
-        stats.rays += rays;
+        backward_pass(
+            scene, &store, settings, opts, &mut image, &progress, &mut stats,
+        )?;
         for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
             *s += *p;
         }
@@ -333,6 +324,30 @@ pub fn render(
         }
     }
     Ok((sum, stats))
+}
+
+/// The backward pass against one caustic store, into `image`, on `opts.threads`
+/// threads, adding its time, its gather time and its rays to `stats`.
+fn backward_pass<S: CausticStore + Sync>(
+    scene: &DesktopScene,
+    store: &S,
+    settings: &PhotonSettings,
+    opts: &RenderOptions,
+    image: &mut Image,
+    progress: &Progress,
+    stats: &mut RenderStats,
+) -> Result<(), Error> {
+    let timed = Timed {
+        inner: store,
+        nanos: AtomicU64::new(0),
+    };
+    let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
+        Renderer::new(scene, &timed, settings.max_depth())?.with_supersample(opts.supersample)?;
+    let t = Instant::now();
+    stats.rays += render_rows(&renderer, image, opts.threads.max(1), progress);
+    stats.render_ms += ms(t.elapsed());
+    stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
+    Ok(())
 }
 
 /// Renders all rows of `image` on `threads` threads, each taking the next free row.
@@ -472,17 +487,10 @@ pub fn render_illumination(
     drop(photons);
     stats.balance_ms += ms(t.elapsed());
     let progress = Progress::new(opts.progress && std::io::stderr().is_terminal(), h as usize);
-    let timed = Timed {
-        inner: &maps,
-        nanos: AtomicU64::new(0),
-    };
-    let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
-        Renderer::new(scene, &timed, settings.max_depth())?.with_supersample(opts.supersample)?;
     let mut image = Image::new(w, h);
-    let t = Instant::now();
-    stats.rays = render_rows(&renderer, &mut image, threads, &progress);
-    stats.render_ms += ms(t.elapsed());
-    stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
+    backward_pass(
+        scene, &maps, settings, opts, &mut image, &progress, &mut stats,
+    )?;
     progress.finish();
     Ok((image, stats, map_stats))
 }

@@ -479,17 +479,17 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
         p.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
     )
     .map_err(|e| core_err("photons", e, &["k", "max_radius", "max_depth", "count"]))?;
-    if p.k.unwrap_or(DEFAULT_K) as usize > super::MAX_GATHER {
+    if photons.k() as usize > super::MAX_GATHER {
         return Err(err(
             "photons.k",
             format!(
                 "{} exceeds the gather capacity {}",
-                p.k.unwrap_or(0),
+                photons.k(),
                 super::MAX_GATHER
             ),
         ));
     }
-    if p.max_depth.unwrap_or(DEFAULT_MAX_DEPTH) as usize > super::MAX_DEPTH {
+    if photons.max_depth() as usize > super::MAX_DEPTH {
         return Err(err(
             "photons.max_depth",
             format!("exceeds the path stack capacity {}", super::MAX_DEPTH),
