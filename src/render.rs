@@ -12,6 +12,22 @@
 //!   reflectivity·L_reflected + transparency·L_refracted`, where `kernel` is eq. 8's
 //!   summand with the light as its single photon.
 //!
+//! Caustic light at a diffuse hit comes from one of two estimators. Where the eye sees
+//! the surface directly, the forward pass has already added it to the pixel by light
+//! tracing ([`photon::Splat`](crate::photon::Splat), given to
+//! [`Renderer::with_splats`]): unbiased and exactly a pixel-area average. Where the eye
+//! sees it through glass or in a mirror, the caustic store gathers, within the
+//! footprint of the pixel's ray cone (`½·pixel angle·path length`, bounded by the
+//! store's own radius). Without splats the store gathers at every diffuse hit, as in
+//! the paper.
+//!
+//! A pixel's value is the average radiance over its area (box filter). The default
+//! [`Sampling::Adaptive`] traces the pixel's four corners (Whitted 1980's adaptive
+//! supersampling) and averages them where they agree — the same objects along the
+//! path, the same lights visible, luminance within a small contrast — and otherwise
+//! averages an `n × n` grid of sub-pixel rays: shadow edges, silhouettes and what is
+//! seen through glass get many rays, smooth regions one per pixel.
+//!
 //! A path takes at most `max_depth` specular interactions; one that meets a further
 //! specular surface contributes nothing. The tree of reflected and refracted branches
 //! is walked depth-first with an explicit stack of `DEPTH` entries: each pending entry
@@ -23,7 +39,7 @@ use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
-use crate::photon::CausticStore;
+use crate::photon::{add_to_row, CausticStore, Splat};
 use crate::scene::Scene;
 
 /// Rays traced, for statistics.
@@ -33,14 +49,36 @@ pub struct RayCount {
     pub eye: u64,
     /// Shadow rays towards lights.
     pub shadow: u64,
+    /// Pixels whose corners disagreed and were supersampled.
+    pub refined: u64,
 }
 
 impl core::ops::AddAssign for RayCount {
     fn add_assign(&mut self, o: Self) {
         self.eye += o.eye;
         self.shadow += o.shadow;
+        self.refined += o.refined;
     }
 }
+
+/// How a pixel's area is sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// One ray through the pixel centre (the paper; a point estimate of the pixel).
+    Centre,
+    /// `n × n` rays through the centres of an `n × n` grid of sub-pixels, averaged.
+    Grid(u32),
+    /// The four corners, averaged where they agree; an `n × n` grid where they do not
+    /// (different objects along the paths, different lights visible, or a luminance
+    /// contrast `(max − min)/(max + min)` above [`CONTRAST`]).
+    Adaptive(u32),
+}
+
+/// The corner contrast above which [`Sampling::Adaptive`] supersamples a pixel.
+pub const CONTRAST: f32 = 0.04;
+
+/// The default sub-pixel grid side of [`Sampling::Adaptive`].
+pub const REFINE: u32 = 4;
 
 /// One pending branch of an eye path.
 #[derive(Clone, Copy, Debug)]
@@ -48,6 +86,23 @@ struct Branch {
     ray: Ray,
     weight: Rgb,
     depth: u32,
+    /// Distance travelled from the eye to the ray's origin.
+    travelled: f32,
+}
+
+/// Radiance along one eye ray, and a signature of what the path met: which objects,
+/// in which order, and which lights were visible at each shaded point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Radiance.
+    pub radiance: Rgb,
+    /// FNV-1a hash of the path's events.
+    pub signature: u32,
+}
+
+#[inline]
+fn mix(h: u32, v: u32) -> u32 {
+    (h ^ v).wrapping_mul(0x0100_0193)
 }
 
 /// Renders a scene against a caustic store, with a path stack of `DEPTH` entries.
@@ -56,14 +111,20 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     scene: &'a Scene<OBJECTS, LIGHTS>,
     store: &'a S,
     max_depth: u32,
-    /// Eye rays per pixel side: `n × n` per pixel.
-    samples: u32,
+    sampling: Sampling,
+    /// The camera's splats, when the forward pass made them: then the store gathers
+    /// only at diffuse points seen through glass or mirrors.
+    splats: Option<&'a [Splat]>,
+    /// Gather radius per unit of path length (`½·pixel angle·shrink`).
+    footprint: f32,
 }
 
 impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     Renderer<'a, S, O, L, DEPTH>
 {
-    /// A renderer; an error when `max_depth` exceeds the compiled stack `DEPTH`.
+    /// A renderer with one ray per pixel centre and the store gathering at every
+    /// diffuse hit (the paper's method); an error when `max_depth` exceeds the compiled
+    /// stack `DEPTH`.
     pub fn new(scene: &'a Scene<O, L>, store: &'a S, max_depth: u32) -> Result<Self, Error> {
         if max_depth as usize > DEPTH {
             return Err(Error::Capacity {
@@ -76,24 +137,48 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             scene,
             store,
             max_depth,
-            samples: 1,
+            sampling: Sampling::Centre,
+            splats: None,
+            footprint: 0.5 * scene.camera().pixel_angle(),
         })
     }
 
-    /// Supersampling: `n × n` eye rays per pixel on a regular grid of sub-pixel centres,
-    /// averaged (a box filter: the pixel-area average a sensor records). `n = 1`, the
-    /// default, is the one ray through the pixel centre of the scene format.
-    pub fn with_supersample(mut self, n: u32) -> Result<Self, Error> {
-        if !(1..=64).contains(&n) {
-            return Err(Error::OutOfRange {
-                what: "supersample",
-                value: n as f32,
-                min: 1.0,
-                max: 64.0,
-            });
+    /// The caustics seen directly come from these splats of the forward pass (in
+    /// emission order): [`rows`](Self::rows) adds them to their pixels, and the store
+    /// gathers only where a diffuse point is seen through glass or in a mirror, within
+    /// the pixel's footprint. [`row`](Self::row) does not add them (the desktop adds
+    /// all at once with [`add_to_frame`](crate::photon::add_to_frame)).
+    pub fn with_splats(mut self, splats: &'a [Splat]) -> Self {
+        self.splats = Some(splats);
+        self
+    }
+
+    /// Scales the gather footprint (progressive passes shrink it with the radius).
+    pub fn with_footprint_scale(mut self, scale: f32) -> Self {
+        self.footprint = 0.5 * self.scene.camera().pixel_angle() * scale;
+        self
+    }
+
+    /// How pixels are sampled; an error for a grid side outside `1..=64`.
+    pub fn with_sampling(mut self, sampling: Sampling) -> Result<Self, Error> {
+        if let Sampling::Grid(n) | Sampling::Adaptive(n) = sampling {
+            if !(1..=64).contains(&n) {
+                return Err(Error::OutOfRange {
+                    what: "supersample",
+                    value: n as f32,
+                    min: 1.0,
+                    max: 64.0,
+                });
+            }
         }
-        self.samples = n;
+        self.sampling = sampling;
         Ok(self)
+    }
+
+    /// Supersampling: `n × n` eye rays per pixel on a regular grid of sub-pixel centres,
+    /// averaged: [`Sampling::Grid`].
+    pub fn with_supersample(self, n: u32) -> Result<Self, Error> {
+        self.with_sampling(Sampling::Grid(n))
     }
 
     /// The scene.
@@ -103,21 +188,30 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// Radiance arriving at the origin of `ray` along it.
     pub fn radiance(&self, ray: Ray, count: &mut RayCount) -> Rgb {
+        self.sample(ray, count).radiance
+    }
+
+    /// Radiance arriving at the origin of `ray` along it, with the path's signature.
+    pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut total = Rgb::ZERO;
+        let mut signature = 0x811c_9dc5u32;
         let mut next = Some(Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
+            travelled: 0.0,
         });
         while let Some(b) = next.take().or_else(|| stack.pop()) {
             count.eye += 1;
             let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
+                signature = mix(signature, u32::MAX);
                 total += b.weight * self.scene.background();
                 continue;
             };
+            signature = mix(signature, index as u32 | b.depth << 16);
             let material = &self.scene.objects()[index].material;
-            let (local, first, second) = self.scatter(&b, &hit, material, count);
+            let (local, first, second) = self.scatter(&b, &hit, material, count, &mut signature);
             total += local;
             // Continue with one branch, keep the other for later (a different depth
             // from every branch already waiting, so the stack never overflows).
@@ -128,7 +222,22 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
             }
         }
-        total
+        Sample {
+            radiance: total,
+            signature,
+        }
+    }
+
+    /// The caustic store's part at a diffuse point reached by branch `b`: none where
+    /// the splats already hold it (seen directly), else the gather, bounded by the
+    /// footprint of the pixel's ray cone when splats are in use.
+    #[inline]
+    fn gather_radius(&self, b: &Branch, hit: &Hit) -> Option<f32> {
+        match self.splats {
+            None => Some(f32::INFINITY),
+            Some(_) if b.depth == 0 => None,
+            Some(_) => Some(self.footprint * (b.travelled + hit.t)),
+        }
     }
 
     /// Light leaving `hit` towards the eye directly, and up to two specular branches.
@@ -139,6 +248,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         hit: &Hit,
         material: &Material,
         count: &mut RayCount,
+        signature: &mut u32,
     ) -> (Rgb, Option<Branch>, Option<Branch>) {
         let d = b.ray.dir;
         let front = hit.front_face(d);
@@ -149,6 +259,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 ray: Ray::spawn(hit, dir),
                 weight: w,
                 depth: b.depth + 1,
+                travelled: b.travelled + hit.t,
             })
         };
         match material {
@@ -156,9 +267,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !front {
                     return (Rgb::ZERO, None, None);
                 }
-                let mut e = self.store.irradiance(hit.point, hit.normal);
+                let mut e = match self.gather_radius(b, hit) {
+                    Some(r) => self.store.irradiance_within(hit.point, hit.normal, r),
+                    None => Rgb::ZERO,
+                };
                 for light in self.scene.lights() {
-                    if let Some((l, irradiance)) = self.direct_one(hit, light, count) {
+                    let lit = self.direct_one(hit, light, count);
+                    *signature = mix(*signature, lit.is_some() as u32);
+                    if let Some((l, irradiance)) = lit {
                         e += irradiance * hit.normal.dot(l.get());
                     }
                 }
@@ -189,7 +305,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(hit, c, -d, count)
+                    self.classic_local(b, hit, c, -d, count, signature)
                 } else {
                     Rgb::ZERO
                 };
@@ -209,16 +325,30 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// The classic model's local part at a front-side hit seen from `to_eye`.
-    fn classic_local(&self, hit: &Hit, c: &Classic, to_eye: UnitVec3, count: &mut RayCount) -> Rgb {
+    fn classic_local(
+        &self,
+        b: &Branch,
+        hit: &Hit,
+        c: &Classic,
+        to_eye: UnitVec3,
+        count: &mut RayCount,
+        signature: &mut u32,
+    ) -> Rgb {
         let n = hit.normal;
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
-            if let Some((l, e)) = self.direct_one(hit, light, count) {
+            let seen = self.direct_one(hit, light, count);
+            *signature = mix(*signature, seen.is_some() as u32);
+            if let Some((l, e)) = seen {
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        ambient + lit + self.store.classic(hit.point, n, to_eye, c)
+        let caustic = match self.gather_radius(b, hit) {
+            Some(r) => self.store.classic_within(hit.point, n, to_eye, c, r),
+            None => Rgb::ZERO,
+        };
+        ambient + lit + caustic
     }
 
     /// Direction `l` and normal-incidence irradiance `I/d²` of one light if it shines
@@ -251,47 +381,126 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         Some((l, light.intensity() * (1.0 / d2)))
     }
 
-    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width).
+    /// The average of an `n × n` grid of sub-pixel rays over pixel `(x, y)`.
+    fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> Rgb {
+        let (step, inv) = (1.0 / n as f32, 1.0 / (n * n) as f32);
+        let camera = self.scene.camera();
+        let mut sum = Rgb::ZERO;
+        for sy in 0..n {
+            for sx in 0..n {
+                let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
+                sum += self.radiance(camera.ray_at(x, y, fx, fy), count);
+            }
+        }
+        sum * inv
+    }
+
+    /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
+    #[inline]
+    fn corner(&self, cx: u32, cy: u32, count: &mut RayCount) -> Sample {
+        self.sample(self.scene.camera().ray_at(cx, cy, 0.0, 0.0), count)
+    }
+
+    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width), without the
+    /// splats (see [`with_splats`](Self::with_splats)).
     pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
         let mut count = RayCount::default();
         let camera = self.scene.camera();
-        let n = self.samples;
-        if n == 1 {
-            for (x, px) in row.iter_mut().enumerate() {
-                *px = self.radiance(camera.ray(x as u32, y), &mut count);
-            }
-            return count;
-        }
-        let (step, inv) = (1.0 / n as f32, 1.0 / (n * n) as f32);
-        for (x, px) in row.iter_mut().enumerate() {
-            let mut sum = Rgb::ZERO;
-            for sy in 0..n {
-                for sx in 0..n {
-                    let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
-                    sum += self.radiance(camera.ray_at(x as u32, y, fx, fy), &mut count);
+        match self.sampling {
+            Sampling::Centre => {
+                for (x, px) in row.iter_mut().enumerate() {
+                    *px = self.radiance(camera.ray(x as u32, y), &mut count);
                 }
             }
-            *px = sum * inv;
+            Sampling::Grid(n) => {
+                for (x, px) in row.iter_mut().enumerate() {
+                    *px = self.grid(x as u32, y, n, &mut count);
+                }
+            }
+            Sampling::Adaptive(n) => {
+                // Corners shared along the row: the left pair comes from the pixel before.
+                let mut top = self.corner(0, y, &mut count);
+                let mut bottom = self.corner(0, y + 1, &mut count);
+                for (x, px) in row.iter_mut().enumerate() {
+                    let x = x as u32;
+                    let right_top = self.corner(x + 1, y, &mut count);
+                    let right_bottom = self.corner(x + 1, y + 1, &mut count);
+                    let corners = [top, right_top, bottom, right_bottom];
+                    *px = if agree(&corners) {
+                        corners.iter().fold(Rgb::ZERO, |a, c| a + c.radiance) * 0.25
+                    } else {
+                        count.refined += 1;
+                        self.grid(x, y, n, &mut count)
+                    };
+                    (top, bottom) = (right_top, right_bottom);
+                }
+            }
         }
         count
     }
 
-    /// Renders every row, top to bottom, into the caller's one-row buffer and hands each
-    /// to `sink` before the next is computed: no frame buffer. Stops at the sink's
-    /// first error and returns it.
+    /// Renders every row, top to bottom, into the caller's one-row buffer (at least
+    /// the image width; an error otherwise, before any work), adds the splats that fall
+    /// in it, and hands each to `sink` before the next is computed: no frame buffer.
+    /// Stops at the sink's first error and returns it.
     pub fn rows<E>(
         &self,
         row: &mut [Rgb],
         mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
-    ) -> Result<RayCount, E> {
+    ) -> Result<RayCount, RowsError<E>> {
         let mut count = RayCount::default();
         let width = self.scene.camera().width() as usize;
-        let width = width.min(row.len());
-        let row = &mut row[..width];
+        let Some(row) = row.get_mut(..width) else {
+            return Err(RowsError::Render(Error::Capacity {
+                what: "row buffer (image width)",
+                requested: width,
+                capacity: row.len(),
+            }));
+        };
         for y in 0..self.scene.camera().height() {
             count += self.row(y, row);
-            sink(y, row)?;
+            if let Some(splats) = self.splats {
+                add_to_row(splats, y, row);
+            }
+            sink(y, row).map_err(RowsError::Sink)?;
         }
         Ok(count)
     }
+}
+
+/// Why [`Renderer::rows`] stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RowsError<E> {
+    /// The render could not start (the row buffer is shorter than the image).
+    Render(Error),
+    /// The sink's error.
+    Sink(E),
+}
+
+impl<E: core::fmt::Display> core::fmt::Display for RowsError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            RowsError::Render(e) => write!(f, "{e}"),
+            RowsError::Sink(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// `true` when four corner samples saw the same things and their luminances are within
+/// [`CONTRAST`] (Mitchell 1987's contrast, on luminance).
+fn agree(c: &[Sample; 4]) -> bool {
+    let s = c[0].signature;
+    if c.iter().any(|x| x.signature != s) {
+        return false;
+    }
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    for x in c {
+        let l = x.radiance.luminance();
+        if l < lo {
+            lo = l;
+        }
+        hi = crate::math::max(hi, l);
+    }
+    // `!(a > b)` so that NaN never counts as agreement.
+    !(hi - lo > CONTRAST * (hi + lo))
 }

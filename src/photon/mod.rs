@@ -14,6 +14,7 @@ mod estimate;
 mod illumination;
 pub mod kdtree;
 mod packed;
+mod splat;
 mod trace;
 
 pub use estimate::{ConeFilter, KdStore};
@@ -24,6 +25,7 @@ pub use kdtree::{
     balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
 };
 pub use packed::Photon;
+pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage};
 
 use emit::Emission;
 
@@ -44,6 +46,27 @@ pub trait CausticStore {
 
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
+
+    /// As [`irradiance`](Self::irradiance), from photons within `radius` of `x` at most
+    /// (the footprint of the pixel that sees `x`): a store that gathers within a radius
+    /// bounds it by `radius` as well; others ignore it.
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
+        let _ = radius;
+        self.irradiance(x, n)
+    }
+
+    /// As [`classic`](Self::classic), from photons within `radius` of `x` at most.
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        to_eye: UnitVec3,
+        material: &Classic,
+        radius: f32,
+    ) -> Rgb {
+        let _ = radius;
+        self.classic(x, n, to_eye, material)
+    }
 }
 
 /// The store of a scene without caustics: no light.
@@ -70,6 +93,7 @@ pub struct PhotonSettings {
     full_sphere: bool,
     store_direct: bool,
     fixed_radius: bool,
+    splat: bool,
 }
 
 impl PhotonSettings {
@@ -94,6 +118,7 @@ impl PhotonSettings {
             full_sphere: false,
             store_direct: false,
             fixed_radius: false,
+            splat: true,
         })
     }
 
@@ -123,6 +148,19 @@ impl PhotonSettings {
     pub fn with_fixed_radius(mut self, fixed_radius: bool) -> Self {
         self.fixed_radius = fixed_radius;
         self
+    }
+
+    /// Whether the forward pass connects each landed photon to the eye (light tracing
+    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
+    /// backward pass gathers at every diffuse hit, as in the paper.
+    pub fn with_camera_splats(mut self, splat: bool) -> Self {
+        self.splat = splat;
+        self
+    }
+
+    /// `true` when landed photons are connected to the eye.
+    pub fn camera_splats(&self) -> bool {
+        self.splat
     }
 
     /// `true` when every photon within `max_radius` is gathered.
@@ -266,13 +304,20 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
 
     /// Traces photon `i` of light `l` (`i < count(l)`): where it is stored, if anywhere.
     pub fn photon(&self, l: usize, i: u32) -> Option<Photon> {
+        self.land(l, i).map(|x| x.photon)
+    }
+
+    /// Traces photon `i` of light `l` (`i < count(l)`): the photon to store, if it
+    /// landed, and (when the settings ask for camera splats) its splat if the eye sees
+    /// where it landed.
+    pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
         let (emission, shift) = self.plans.get(l)?;
         let light = &self.scene.lights()[l];
         let (dir, power) = emission.photon(light, i, *shift);
         let mut rng = Pcg32::new(hash(&[self.seed, self.pass as u64, l as u64, i as u64]));
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
-        let hit = trace::trace(
+        let landing = trace::trace(
             self.scene,
             ray,
             power,
@@ -280,8 +325,65 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             s.store_direct,
             &mut rng,
         )?;
-        Some(Photon::new(hit.pos, hit.dir, hit.power * (1.0 / self.unit)))
+        let material = &self.scene.objects()[landing.object].material;
+        let splat = if s.splat {
+            splat::connect(
+                self.scene,
+                &landing.hit,
+                material,
+                landing.dir,
+                landing.power,
+            )
+        } else {
+            None
+        };
+        Some(Landed {
+            photon: Photon::new(
+                landing.hit.point,
+                landing.dir,
+                landing.power * (1.0 / self.unit),
+            ),
+            splat,
+        })
     }
+}
+
+/// What one traced photon left: the photon to store, and its splat into the image when
+/// the eye sees where it landed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Landed {
+    /// The photon for the caustic store.
+    pub photon: Photon,
+    /// Its light-tracing contribution to the pixel it projects into.
+    pub splat: Option<Splat>,
+}
+
+/// The forward pass, photon by photon in emission order: `f` receives what each traced
+/// photon left (see [`Emitter::land`]) and may stop the pass with an error. Photon `i`
+/// of light `l` is the same whatever else is traced, so this is the one loop every
+/// forward pass runs (the desktop runs it on chunks of `(l, i)` on several threads).
+pub fn forward<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    mut f: impl FnMut(&Landed) -> Result<(), Error>,
+) -> Result<ForwardStats, Error> {
+    let emitter = Emitter::new(scene, settings, seed, pass);
+    let mut stats = ForwardStats {
+        emitted: emitter.emitted(),
+        stored: 0,
+        power_unit: emitter.power_unit(),
+    };
+    for l in 0..scene.lights().len() {
+        for i in 0..emitter.count(l) {
+            if let Some(x) = emitter.land(l, i) {
+                f(&x)?;
+                stats.stored += 1;
+            }
+        }
+    }
+    Ok(stats)
 }
 
 /// The forward pass of [`shoot`], handing each photon it would store to `f` instead of
@@ -294,33 +396,37 @@ pub fn for_each_photon<const O: usize, const L: usize>(
     pass: u32,
     mut f: impl FnMut(&Photon),
 ) -> ForwardStats {
-    let emitter = Emitter::new(scene, settings, seed, pass);
-    let mut stats = ForwardStats {
-        emitted: emitter.emitted(),
-        stored: 0,
-        power_unit: emitter.power_unit(),
-    };
-    for l in 0..scene.lights().len() {
-        for i in 0..emitter.count(l) {
-            if let Some(p) = emitter.photon(l, i) {
-                f(&p);
-                stats.stored += 1;
-            }
-        }
-    }
-    stats
+    let settings = settings.with_camera_splats(false);
+    forward(scene, &settings, seed, pass, |x| {
+        f(&x.photon);
+        Ok(())
+    })
+    .unwrap_or_default()
 }
 
 /// The forward pass: shoots `settings.count` photons from each light (see [`Emitter`])
 /// and stores those that land on a diffuse surface after a specular bounce, in
 /// emission order, into `out[..stored]` (not yet balanced). An error when `out` cannot
-/// hold `count × lights` photons.
+/// hold `count × lights` photons. Camera splats are not kept: see [`shoot_with_splats`].
 pub fn shoot<const O: usize, const L: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
     seed: u64,
     pass: u32,
     out: &mut [Photon],
+) -> Result<ForwardStats, Error> {
+    shoot_with_splats(scene, settings, seed, pass, out, &mut ())
+}
+
+/// As [`shoot`], also keeping the camera splats (see [`Splat`]) in `splats`, emptied
+/// first. An error when `splats` is full.
+pub fn shoot_with_splats<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    out: &mut [Photon],
+    splats: &mut impl SplatStorage,
 ) -> Result<ForwardStats, Error> {
     let needed = photons_needed(scene, settings);
     if needed > out.len() {
@@ -330,12 +436,16 @@ pub fn shoot<const O: usize, const L: usize>(
             capacity: out.len(),
         });
     }
+    splats.clear_splats();
     let mut n = 0;
-    let stats = for_each_photon(scene, settings, seed, pass, |p| {
-        out[n] = *p;
+    forward(scene, settings, seed, pass, |x| {
+        out[n] = x.photon;
         n += 1;
-    });
-    Ok(stats)
+        match x.splat {
+            Some(s) => splats.push_splat(s),
+            None => Ok(()),
+        }
+    })
 }
 
 /// A photon map of fixed capacity `N`: the photons live in an array inside it, so its
@@ -363,26 +473,40 @@ impl<const N: usize> PhotonMap<N> {
         }
     }
 
-    /// Runs the forward pass into this map and balances it: see [`shoot`].
+    /// Runs the forward pass into this map and balances it: see [`shoot`]. The
+    /// camera's splats are dropped: see [`build_with_splats`](Self::build_with_splats).
     pub fn build<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
     ) -> Result<ForwardStats, Error> {
-        self.build_pass(scene, settings, seed, 0)
+        self.build_pass(scene, settings, seed, 0, &mut ())
     }
 
-    /// As [`build`](Self::build), for progressive pass number `pass`.
+    /// As [`build`](Self::build), keeping the camera splats in `splats` (for
+    /// [`Renderer::with_splats`](crate::render::Renderer::with_splats)).
+    pub fn build_with_splats<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+        splats: &mut impl SplatStorage,
+    ) -> Result<ForwardStats, Error> {
+        self.build_pass(scene, settings, seed, 0, splats)
+    }
+
+    /// As [`build_with_splats`](Self::build_with_splats), for progressive pass `pass`.
     pub fn build_pass<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
         pass: u32,
+        splats: &mut impl SplatStorage,
     ) -> Result<ForwardStats, Error> {
         self.len = 0;
-        let stats = shoot(scene, settings, seed, pass, &mut self.photons)?;
+        let stats = shoot_with_splats(scene, settings, seed, pass, &mut self.photons, splats)?;
         self.len = stats.stored;
         self.unit = stats.power_unit;
         balance(&mut self.photons[..self.len]);

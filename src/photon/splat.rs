@@ -1,0 +1,137 @@
+//! Light tracing into the image: caustic light the camera sees directly.
+//!
+//! A photon that lands on a surface with a diffuse part, where the eye sees that
+//! surface directly (nothing in between), is connected to the pinhole and adds its
+//! reflected light to the pixel it projects into. Summed over photons this is an
+//! unbiased estimate of the pixel-area average of the caustic radiance seen directly
+//! (the `L S+ D E` paths; Veach 1997 §10.2, pbrt-v4's light tracer): no kernel, no
+//! radius, no bias at a caustic's sharp edge or focus. Caustics seen through glass or
+//! in a mirror (`L S+ D S+ E`) cannot be connected to a pinhole and stay with the
+//! caustic store's gather.
+//!
+//! Splats are kept in emission order; a row adds the splats of its pixels in that order,
+//! so the device (which scans the list row by row) and the desktop (which adds the whole
+//! list once into its frame) sum every pixel in the same order and agree bit for bit.
+
+use crate::error::Error;
+use crate::geometry::{Hit, Ray};
+use crate::material::Material;
+use crate::math::{Rgb, UnitVec3};
+use crate::scene::Scene;
+
+/// One photon's contribution to one pixel's average radiance.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Splat {
+    /// Pixel index `y·W + x`.
+    pub pixel: u32,
+    /// Radiance added to the pixel's value (W/(m²·sr) per channel).
+    pub radiance: Rgb,
+}
+
+impl Splat {
+    /// The empty splat, for initialising arrays.
+    pub const ZERO: Splat = Splat {
+        pixel: 0,
+        radiance: Rgb::ZERO,
+    };
+}
+
+/// Where a forward pass puts the splats it makes, in emission order: a fixed array on
+/// the device (`heapless::Vec`), a `Vec` on the desktop. Full storage is an error.
+pub trait SplatStorage {
+    /// Appends one splat.
+    fn push_splat(&mut self, s: Splat) -> Result<(), Error>;
+    /// Empties the storage (a new pass).
+    fn clear_splats(&mut self);
+}
+
+impl<const S: usize> SplatStorage for heapless::Vec<Splat, S> {
+    fn push_splat(&mut self, s: Splat) -> Result<(), Error> {
+        self.push(s).map_err(|_| Error::Capacity {
+            what: "splats (photons seen directly)",
+            requested: S + 1,
+            capacity: S,
+        })
+    }
+    fn clear_splats(&mut self) {
+        self.clear();
+    }
+}
+
+/// Drops every splat: a forward pass for a renderer that gathers everywhere.
+impl SplatStorage for () {
+    fn push_splat(&mut self, _: Splat) -> Result<(), Error> {
+        Ok(())
+    }
+    fn clear_splats(&mut self) {}
+}
+
+#[cfg(feature = "std")]
+impl SplatStorage for std::vec::Vec<Splat> {
+    fn push_splat(&mut self, s: Splat) -> Result<(), Error> {
+        self.push(s);
+        Ok(())
+    }
+    fn clear_splats(&mut self) {
+        self.clear();
+    }
+}
+
+/// Connects a photon that landed at `hit` on `material`, travelling along `dir` with
+/// `power` (W), to the eye: `None` when the eye is behind the surface, the point is
+/// outside the image, or anything lies between (one shadow ray; every object blocks).
+///
+/// The radiance added is `f·Φ·|n·(e − p)|/(A·z³)` ([`Camera::project`]), with
+/// `f` the material's response to light from `−dir` seen from the eye
+/// ([`Material::caustic_response`]).
+///
+/// [`Camera::project`]: crate::camera::Camera::project
+pub(crate) fn connect<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    hit: &Hit,
+    material: &Material,
+    dir: UnitVec3,
+    power: Rgb,
+) -> Option<Splat> {
+    let camera = scene.camera();
+    let pr = camera.project(hit.point, hit.normal)?;
+    // The eye must be on the side the photon arrived from (the lit side).
+    if !(hit.normal.dot(pr.to_eye.get()) > 0.0) {
+        return None;
+    }
+    let ray = Ray::spawn(hit, pr.to_eye);
+    let reach = crate::math::sqrt((camera.position() - ray.origin).length_squared());
+    if scene.occluded(&ray, reach) {
+        return None;
+    }
+    let f = material.caustic_response(hit.normal, -dir, pr.to_eye);
+    let radiance = f * power * pr.factor;
+    (!radiance.is_black()).then_some(Splat {
+        pixel: pr.pixel,
+        radiance,
+    })
+}
+
+/// Adds to `row` (row `y` of an image `row.len()` pixels wide) the splats that fall in
+/// it, in their order. Scans the whole list: the device's splat list is short.
+pub fn add_to_row(splats: &[Splat], y: u32, row: &mut [Rgb]) {
+    let width = row.len() as u32;
+    let start = y.saturating_mul(width);
+    for s in splats {
+        if let Some(i) = s.pixel.checked_sub(start) {
+            if let Some(px) = row.get_mut(i as usize) {
+                *px += s.radiance;
+            }
+        }
+    }
+}
+
+/// Adds every splat to a whole frame (`frame.len()` = W·H, row-major), in order: the
+/// same sums as [`add_to_row`] row by row.
+pub fn add_to_frame(splats: &[Splat], frame: &mut [Rgb]) {
+    for s in splats {
+        if let Some(px) = frame.get_mut(s.pixel as usize) {
+            *px += s.radiance;
+        }
+    }
+}
