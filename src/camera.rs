@@ -22,6 +22,9 @@ pub struct Camera {
 /// The largest image side accepted (keeps pixel arithmetic exact in `f32`).
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
 
+/// Images have fewer pixels than this (a pixel index fits in 31 bits).
+pub const MAX_PIXELS: u64 = 1 << 31;
+
 impl Camera {
     /// A camera looking from `position` at `look_at`, `fov_y_deg` in (0, 180) degrees,
     /// rendering `width × height` pixels.
@@ -51,6 +54,14 @@ impl Camera {
                     max: MAX_IMAGE_SIDE as f32,
                 });
             }
+        }
+        if width as u64 * height as u64 >= MAX_PIXELS {
+            return Err(Error::OutOfRange {
+                what: "image width × height",
+                value: (width as u64 * height as u64) as f32,
+                min: 1.0,
+                max: MAX_PIXELS as f32,
+            });
         }
         let half_h = libm::tanf(0.5 * fov * (core::f32::consts::PI / 180.0));
         let half_w = half_h * width as f32 / height as f32;

@@ -237,8 +237,13 @@ pub fn photons_needed<const O: usize, const L: usize>(
 /// `(scene, settings, seed, pass, l, i)`, so a pass can be split among threads in any
 /// way and still store the same photons.
 ///
-/// Photon `i` of light `l` in pass `pass` draws its direction from a Hammersley set
-/// shifted by `hash(seed, pass, l)` and its random choices from a PCG32 stream keyed by
+/// Each light's `n` photons are two independent halves — photon `i` belongs to half
+/// `h = i mod 2`, as photon `⌊i/2⌋` of a Hammersley set of `n_h` points (`n_0 = ⌈n/2⌉`,
+/// `n_1 = ⌊n/2⌋`) shifted by `hash(seed, pass, l, h)` (a Cranley–Patterson rotation:
+/// randomised quasi-Monte Carlo). Each half alone is an unbiased estimate; a photon
+/// carries `n_h/n` of its half's power, so the two add up to one estimate from `n`
+/// photons, and their difference measures that estimate's error (Owen 1997; see
+/// [`Splat::half`]). The random choices of photon `i` come from a PCG32 stream keyed by
 /// `hash(seed, pass, l, i)`. A scene with no mirror, glass or reflective/transparent
 /// classic object emits nothing, and so does a dark light.
 #[derive(Clone, Debug)]
@@ -247,9 +252,18 @@ pub struct Emitter<'a, const O: usize, const L: usize> {
     settings: PhotonSettings,
     seed: u64,
     pass: u32,
-    /// Per light: its emission plan and the point set's shift.
-    plans: heapless::Vec<(Emission<O>, (f32, f32)), L>,
+    /// Per light, per half: the emission plan, the point set's shift and the share
+    /// `n_h/n` of the light's photons.
+    plans: heapless::Vec<[Half<O>; 2], L>,
     unit: f32,
+}
+
+/// One half of a light's photons.
+#[derive(Clone, Debug)]
+struct Half<const O: usize> {
+    plan: Emission<O>,
+    shift: (f32, f32),
+    share: f32,
 }
 
 impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
@@ -265,13 +279,23 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             } else {
                 0
             };
-            let plan = Emission::<O>::plan(scene, light, count, full_sphere);
-            if count > 0 {
-                unit = unit.max(plan.nominal_power(light));
+            let half = |h: u32| {
+                let n = (count + 1 - h) / 2;
+                let key = hash(&[seed, pass as u64, l as u64, h as u64]);
+                Half {
+                    plan: Emission::<O>::plan(scene, light, n, full_sphere),
+                    shift: (unit_f32(key as u32), unit_f32((key >> 32) as u32)),
+                    share: n as f32 / count.max(1) as f32,
+                }
+            };
+            let halves = [half(0), half(1)];
+            for h in &halves {
+                if h.plan.count() > 0 {
+                    unit = unit.max(h.plan.nominal_power(light) * h.share);
+                }
             }
-            let key = hash(&[seed, pass as u64, l as u64]);
-            // Cannot overflow: one plan per light, at most L lights.
-            let _ = plans.push((plan, (unit_f32(key as u32), unit_f32((key >> 32) as u32))));
+            // Cannot overflow: one entry per light, at most L lights.
+            let _ = plans.push(halves);
         }
         if !(unit > 0.0 && unit.is_finite()) {
             plans.clear(); // nothing to emit
@@ -294,7 +318,9 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
 
     /// Photons light `l` emits (0 for a dark light or when nothing is emitted).
     pub fn count(&self, l: usize) -> u32 {
-        self.plans.get(l).map_or(0, |p| p.0.count())
+        self.plans
+            .get(l)
+            .map_or(0, |p| p[0].plan.count() + p[1].plan.count())
     }
 
     /// Photons emitted by all lights.
@@ -311,9 +337,10 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
     /// landed, and (when the settings ask for camera splats) its splat if the eye sees
     /// where it landed.
     pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
-        let (emission, shift) = self.plans.get(l)?;
+        let half = &self.plans.get(l)?[(i & 1) as usize];
         let light = &self.scene.lights()[l];
-        let (dir, power) = emission.photon(light, i, *shift);
+        let (dir, power) = half.plan.photon(light, i >> 1, half.shift);
+        let power = power * half.share;
         let mut rng = Pcg32::new(hash(&[self.seed, self.pass as u64, l as u64, i as u64]));
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
@@ -333,6 +360,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 material,
                 landing.dir,
                 landing.power,
+                i & 1 == 1,
             )
         } else {
             None

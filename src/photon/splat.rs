@@ -19,21 +19,45 @@ use crate::material::Material;
 use crate::math::{Rgb, UnitVec3};
 use crate::scene::Scene;
 
-/// One photon's contribution to one pixel's average radiance.
+/// One photon's contribution to one pixel's average radiance: 16 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Splat {
-    /// Pixel index `y·W + x`.
-    pub pixel: u32,
+    /// Pixel index `y·W + x` in bits 0–30; bit 31: the photon's half (see
+    /// [`Emitter`](super::Emitter)). Images have fewer than 2³¹ pixels.
+    key: u32,
     /// Radiance added to the pixel's value (W/(m²·sr) per channel).
     pub radiance: Rgb,
 }
 
+const HALF_BIT: u32 = 1 << 31;
+
 impl Splat {
     /// The empty splat, for initialising arrays.
     pub const ZERO: Splat = Splat {
-        pixel: 0,
+        key: 0,
         radiance: Rgb::ZERO,
     };
+
+    /// A splat of `radiance` into pixel `pixel` (< 2³¹) from a photon of half `half`.
+    pub fn new(pixel: u32, radiance: Rgb, half: bool) -> Self {
+        Self {
+            key: (pixel & !HALF_BIT) | if half { HALF_BIT } else { 0 },
+            radiance,
+        }
+    }
+
+    /// The pixel index `y·W + x`.
+    #[inline]
+    pub fn pixel(&self) -> u32 {
+        self.key & !HALF_BIT
+    }
+
+    /// Which of the forward pass's two independent halves the photon came from: the
+    /// difference of the halves' sums in a pixel estimates the error of their total.
+    #[inline]
+    pub fn half(&self) -> bool {
+        self.key & HALF_BIT != 0
+    }
 }
 
 /// Where a forward pass puts the splats it makes, in emission order: a fixed array on
@@ -92,6 +116,7 @@ pub(crate) fn connect<const O: usize, const L: usize>(
     material: &Material,
     dir: UnitVec3,
     power: Rgb,
+    half: bool,
 ) -> Option<Splat> {
     let camera = scene.camera();
     let pr = camera.project(hit.point, hit.normal)?;
@@ -106,10 +131,7 @@ pub(crate) fn connect<const O: usize, const L: usize>(
     }
     let f = material.caustic_response(hit.normal, -dir, pr.to_eye);
     let radiance = f * power * pr.factor;
-    (!radiance.is_black()).then_some(Splat {
-        pixel: pr.pixel,
-        radiance,
-    })
+    (!radiance.is_black()).then(|| Splat::new(pr.pixel, radiance, half))
 }
 
 /// Adds to `row` (row `y` of an image `row.len()` pixels wide) the splats that fall in
@@ -118,7 +140,7 @@ pub fn add_to_row(splats: &[Splat], y: u32, row: &mut [Rgb]) {
     let width = row.len() as u32;
     let start = y.saturating_mul(width);
     for s in splats {
-        if let Some(i) = s.pixel.checked_sub(start) {
+        if let Some(i) = s.pixel().checked_sub(start) {
             if let Some(px) = row.get_mut(i as usize) {
                 *px += s.radiance;
             }
@@ -130,7 +152,7 @@ pub fn add_to_row(splats: &[Splat], y: u32, row: &mut [Rgb]) {
 /// same sums as [`add_to_row`] row by row.
 pub fn add_to_frame(splats: &[Splat], frame: &mut [Rgb]) {
     for s in splats {
-        if let Some(px) = frame.get_mut(s.pixel as usize) {
+        if let Some(px) = frame.get_mut(s.pixel() as usize) {
             *px += s.radiance;
         }
     }
