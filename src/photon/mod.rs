@@ -21,6 +21,8 @@ pub use estimate::{ConeFilter, KdStore};
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
+#[cfg(feature = "std")]
+pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
 pub use kdtree::{
     balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
 };

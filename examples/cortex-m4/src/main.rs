@@ -27,7 +27,7 @@ use caustic::demo;
 use caustic::math::Rgb;
 use caustic::photon::PhotonMap;
 use caustic::raster::{DisplaySink, Dither, ToneMap};
-use caustic::render::Renderer;
+use caustic::render::{Renderer, RowsError};
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hprintln, nr, syscall, syscall1};
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -347,7 +347,10 @@ fn main() -> ! {
         renderer.rows(&mut row, |y, pixels| sink.draw_row(y, pixels))
     };
     caustic_mark_render_end();
-    let rays = rays.unwrap_or_else(|e| fail(e.0));
+    let rays = rays.unwrap_or_else(|e| match e {
+        RowsError::Sink(e) => fail(e.0),
+        RowsError::Render(_) => fail("row buffer"),
+    });
 
     let (pixels, hash) = display.close().unwrap_or_else(|e| fail(e.0));
     hprintln!("rays: {} eye, {} shadow", rays.eye, rays.shadow);
