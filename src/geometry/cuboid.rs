@@ -19,6 +19,8 @@ pub struct Cuboid {
     /// and the error bound so that rounding never lets the sphere test reject a ray
     /// the slab test would hit.
     reject_r2: f32,
+    /// The outward unit normals of the faces, `[axis][0: −, 1: +]`.
+    normals: [[UnitVec3; 2]; 3],
     error: f32,
 }
 
@@ -35,12 +37,19 @@ impl Cuboid {
         let half = size * 0.5;
         let error = error_bound(max_abs(center) + half.length());
         let reject_r = half.length() * (1.0 + 1e-4) + error;
+        let mut normals = [[UnitVec3::X; 2]; 3];
+        for (axis, pair) in normals.iter_mut().enumerate() {
+            for (side, sign) in [-1.0f32, 1.0].into_iter().enumerate() {
+                pair[side] = UnitVec3::try_new(rotation.col(axis) * sign, "box rotation_deg")?;
+            }
+        }
         Ok(Self {
             center,
             half,
             rotation,
             inverse: rotation.transpose(),
             reject_r2: reject_r * reject_r,
+            normals,
             error,
         })
     }
@@ -86,13 +95,15 @@ impl Cuboid {
     /// The slab interval `(t_near, near_axis, t_far, far_axis)` of the ray in the box's
     /// frame (`o`, `d`), by the slab method (Kay & Kajiya 1986); `None` when it is empty.
     /// A direction component of exactly zero is handled apart, so that a ray lying in a
-    /// face plane never produces `0·∞ = NaN`.
+    /// face plane never produces `0·∞ = NaN`. (Arrays, not `Vec3`: glam indexes a
+    /// `Vec3` through a `match`.)
     #[inline]
-    fn slabs(&self, o: Vec3, d: Vec3) -> Option<(f32, usize, f32, usize)> {
+    fn slabs(&self, o: [f32; 3], d: [f32; 3]) -> Option<(f32, usize, f32, usize)> {
+        let half = self.half.to_array();
         let (mut t_near, mut t_far) = (f32::NEG_INFINITY, f32::INFINITY);
         let (mut near_axis, mut far_axis) = (0usize, 0usize);
         for i in 0..3 {
-            let (oi, di, hi) = (o[i], d[i], self.half[i]);
+            let (oi, di, hi) = (o[i], d[i], half[i]);
             if di == 0.0 {
                 if oi < -hi || oi > hi {
                     return None;
@@ -116,6 +127,14 @@ impl Cuboid {
         (t_near <= t_far).then_some((t_near, near_axis, t_far, far_axis))
     }
 
+    /// The ray in the box's frame: origin and direction.
+    #[inline]
+    fn local_ray(&self, ray: &Ray) -> ([f32; 3], [f32; 3]) {
+        let o = self.inverse * (ray.origin - self.center);
+        let d = self.inverse * ray.dir.get();
+        (o.to_array(), d.to_array())
+    }
+
     /// The nearest hit with `0 < t < t_max`: the slab test in the box's frame after the
     /// bounding-sphere test.
     #[inline]
@@ -123,8 +142,7 @@ impl Cuboid {
         if self.surely_missed(ray, t_max) {
             return None;
         }
-        let o = self.inverse * (ray.origin - self.center);
-        let d = self.inverse * ray.dir.get();
+        let (o, d) = self.local_ray(ray);
         let (t_near, near_axis, t_far, far_axis) = self.slabs(o, d)?;
         // Entering through the near face, or leaving through the far one from inside.
         let (t, axis, sign) = if t_near > 0.0 {
@@ -135,14 +153,15 @@ impl Cuboid {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
-        let mut local = o + d * t;
-        local[axis] = sign * self.half[axis];
-        // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
+        let half = self.half.to_array();
+        let mut local = [0.0f32; 3];
         for i in 0..3 {
-            local[i] = crate::math::clamp(local[i], -self.half[i], self.half[i]);
+            // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
+            local[i] = crate::math::clamp(o[i] + d[i] * t, -half[i], half[i]);
         }
-        let point = self.center + self.rotation * local;
-        let normal = UnitVec3::new(self.rotation.col(axis) * sign)?;
+        local[axis] = sign * half[axis];
+        let point = self.center + self.rotation * Vec3::from_array(local);
+        let normal = self.normals[axis][(sign > 0.0) as usize];
         Some(Hit {
             t,
             point,
@@ -160,8 +179,7 @@ impl Cuboid {
         if self.surely_missed(ray, t_max) {
             return false;
         }
-        let o = self.inverse * (ray.origin - self.center);
-        let d = self.inverse * ray.dir.get();
+        let (o, d) = self.local_ray(ray);
         let Some((t_near, _, t_far, _)) = self.slabs(o, d) else {
             return false;
         };

@@ -165,7 +165,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         match self {
             Emission::Sphere { count } => {
                 let (s, t) = hammersley(index, *count, shift);
-                let (sin_u, cos_u) = libm::sincosf(2.0 * PI * s);
+                let (sin_u, cos_u) = crate::math::sin_cos_turns(s);
                 let sin_v = 2.0 * t - 1.0;
                 let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
                 let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
@@ -188,7 +188,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 let om = s * c.one_minus_cos; // 1 − cos θ
                 let cos_t = 1.0 - om;
                 let sin_t = crate::math::sqrt(crate::math::max_num(om * (2.0 - om), 0.0));
-                let (sin_p, cos_p) = libm::sincosf(2.0 * PI * t);
+                let (sin_p, cos_p) = crate::math::sin_cos_turns(t);
                 let d = c.axis.get() * cos_t + (c.e1.get() * cos_p + c.e2.get() * sin_p) * sin_t;
                 let dir = UnitVec3::new(d).unwrap_or(c.axis);
                 let density: f32 = cones

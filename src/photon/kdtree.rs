@@ -268,10 +268,12 @@ impl<'a> KdTree<'a> {
     pub fn search(&self, x: Vec3, mut radius2: f32, mut visit: impl FnMut(usize, f32) -> f32) {
         let photons = self.photons;
         let n = photons.len();
+        // An array, not `Vec3`: glam indexes a `Vec3` by a `match`, an array by address.
+        let xa = x.to_array();
         let plane = |i: usize| {
             let p = &photons[i];
             let axis = p.axis();
-            x[axis] - p.coord(axis)
+            xa[axis] - p.coord(axis)
         };
         let mut i = 0usize;
         loop {
