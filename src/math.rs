@@ -300,8 +300,9 @@ impl Rgb {
     /// instead of two `maxNum`s). All-NaN is not black, as `max_channel` is NaN then.
     #[inline]
     pub fn is_black(self) -> bool {
-        !(self.r > 0.0 || self.g > 0.0 || self.b > 0.0)
-            && !(self.r.is_nan() && self.g.is_nan() && self.b.is_nan())
+        let positive = self.r > 0.0 || self.g > 0.0 || self.b > 0.0;
+        let all_nan = self.r.is_nan() && self.g.is_nan() && self.b.is_nan();
+        !(positive || all_nan)
     }
 
     /// `true` when every channel is finite.

@@ -42,6 +42,7 @@ pub fn linear_to_srgb8(x: f32) -> u8 {
 const FIRST_EXPONENT: u32 = 127 - 13;
 /// The smallest value with a bucket.
 const BUCKET_FLOOR: f32 = 1.0 / 8192.0;
+const _: () = assert!(BUCKET_FLOOR < SRGB8_THRESHOLDS[0] && SRGB8_THRESHOLDS[254] < 1.0);
 /// Shift that keeps the exponent and four mantissa bits of an `f32`.
 const BUCKET_SHIFT: u32 = 19;
 /// Sixteen buckets per octave from 2⁻¹³ up to 1.
@@ -152,7 +153,6 @@ mod tests {
             }
         }
         assert_eq!(BUCKET_FLOOR.to_bits() >> BUCKET_SHIFT, FIRST_EXPONENT << 4);
-        assert!(BUCKET_FLOOR < SRGB8_THRESHOLDS[0] && SRGB8_THRESHOLDS[254] < 1.0);
     }
 
     #[test]
