@@ -5,7 +5,7 @@
 //! paper's `Classic` coefficient model is reproduced as the paper states it.
 
 use crate::error::{in_range, positive, Error};
-use crate::math::{Rgb, UnitVec3};
+use crate::math::{max_num, min_num, sqrt, Rgb, UnitVec3};
 
 /// The closed set of materials.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,9 +169,11 @@ impl Classic {
     /// and the direction towards the eye.
     #[inline]
     pub fn kernel(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
-        let cos_l = n.dot(to_light.get()).max(0.0);
+        let cos_l = max_num(n.dot(to_light.get()), 0.0);
         let spec = match UnitVec3::new(to_light.get() + to_eye.get()) {
-            Some(h) if self.specular > 0.0 => powi_real(n.dot(h.get()).max(0.0), self.shininess),
+            Some(h) if self.specular > 0.0 => {
+                powi_real(max_num(n.dot(h.get()), 0.0), self.shininess)
+            }
             _ => 0.0,
         };
         self.color * (cos_l * self.diffuse + spec * self.specular)
@@ -231,7 +233,7 @@ pub fn interface(d: UnitVec3, n: UnitVec3, eta: f32) -> Interface {
             refracted: None,
         };
     }
-    let cos_t = libm::sqrtf(cos2_t.min(1.0));
+    let cos_t = sqrt(min_num(cos2_t, 1.0));
     // In units of eta_t: eta_i = eta, eta_t = 1.
     let rs = (eta_cos_i - cos_t) / (eta_cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
