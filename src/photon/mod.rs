@@ -27,7 +27,7 @@ pub use kdtree::{
     balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
 };
 pub use packed::Photon;
-pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage};
+pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;
 

@@ -134,15 +134,28 @@ pub(crate) fn connect<const O: usize, const L: usize>(
     (!radiance.is_black()).then(|| Splat::new(pr.pixel, radiance, half))
 }
 
+/// A pixel that splats add to: a radiance, or a pixel with its error estimate.
+pub trait SplatTarget {
+    /// Adds one splat's radiance.
+    fn add_splat(&mut self, s: &Splat);
+}
+
+impl SplatTarget for Rgb {
+    #[inline]
+    fn add_splat(&mut self, s: &Splat) {
+        *self += s.radiance;
+    }
+}
+
 /// Adds to `row` (row `y` of an image `row.len()` pixels wide) the splats that fall in
 /// it, in their order. Scans the whole list: the device's splat list is short.
-pub fn add_to_row(splats: &[Splat], y: u32, row: &mut [Rgb]) {
+pub fn add_to_row<T: SplatTarget>(splats: &[Splat], y: u32, row: &mut [T]) {
     let width = row.len() as u32;
     let start = y.saturating_mul(width);
     for s in splats {
         if let Some(i) = s.pixel().checked_sub(start) {
             if let Some(px) = row.get_mut(i as usize) {
-                *px += s.radiance;
+                px.add_splat(s);
             }
         }
     }
@@ -150,10 +163,10 @@ pub fn add_to_row(splats: &[Splat], y: u32, row: &mut [Rgb]) {
 
 /// Adds every splat to a whole frame (`frame.len()` = W·H, row-major), in order: the
 /// same sums as [`add_to_row`] row by row.
-pub fn add_to_frame(splats: &[Splat], frame: &mut [Rgb]) {
+pub fn add_to_frame<T: SplatTarget>(splats: &[Splat], frame: &mut [T]) {
     for s in splats {
         if let Some(px) = frame.get_mut(s.pixel() as usize) {
-            *px += s.radiance;
+            px.add_splat(s);
         }
     }
 }

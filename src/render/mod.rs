@@ -61,8 +61,14 @@ use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
-use crate::photon::{add_to_row, CausticStore, Splat};
+use crate::photon::{CausticStore, Splat};
+
+mod estimate;
+mod pixels;
+
 use crate::scene::Scene;
+pub use estimate::{ErrorTally, PixelEstimate};
+pub use pixels::{Sampling, CONTRAST, REFINE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -119,25 +125,6 @@ impl core::ops::AddAssign for RayCount {
     }
 }
 
-/// How a pixel's area is sampled.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sampling {
-    /// One ray through the pixel centre (the paper; a point estimate of the pixel).
-    Centre,
-    /// `n × n` rays through the centres of an `n × n` grid of sub-pixels, averaged.
-    Grid(u32),
-    /// The four corners, averaged where they agree; an `n × n` grid where they do not
-    /// (different objects along the paths, different lights visible, or a luminance
-    /// contrast `(max − min)/(max + min)` above [`CONTRAST`]).
-    Adaptive(u32),
-}
-
-/// The corner contrast above which [`Sampling::Adaptive`] supersamples a pixel.
-pub const CONTRAST: f32 = 0.04;
-
-/// The default sub-pixel grid side of [`Sampling::Adaptive`].
-pub const REFINE: u32 = 4;
-
 /// One pending branch of an eye path.
 #[derive(Clone, Copy, Debug)]
 struct Branch {
@@ -148,19 +135,30 @@ struct Branch {
     travelled: f32,
 }
 
-/// Radiance along one eye ray, and a signature of what the path met: which objects,
-/// in which order, and which lights were visible at each shaded point.
+/// Radiance along one eye ray, its caustic part, and a signature of what the path met:
+/// which objects, in which order, and which lights were visible at each shaded point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
     /// Radiance.
     pub radiance: Rgb,
+    /// The part of `radiance` the caustic store gathered.
+    pub caustic: Rgb,
     /// FNV-1a hash of the path's events.
     pub signature: u32,
 }
 
-#[inline]
-fn mix(h: u32, v: u32) -> u32 {
-    (h ^ v).wrapping_mul(0x0100_0193)
+impl Sample {
+    const START: Sample = Sample {
+        radiance: Rgb::ZERO,
+        caustic: Rgb::ZERO,
+        signature: 0x811c_9dc5,
+    };
+
+    /// Folds one event into the signature (FNV-1a).
+    #[inline]
+    fn mix(&mut self, v: u32) {
+        self.signature = (self.signature ^ v).wrapping_mul(0x0100_0193);
+    }
 }
 
 /// Renders a scene against a caustic store, with a path stack of `DEPTH` entries.
@@ -302,8 +300,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Radiance arriving at the origin of `ray` along it, with the path's signature.
     pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
-        let mut total = Rgb::ZERO;
-        let mut signature = 0x811c_9dc5u32;
+        let mut out = Sample::START;
         let mut next = Some(Branch {
             ray,
             weight: Rgb::ONE,
@@ -317,15 +314,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             count.eye += 1;
             let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
-                signature = mix(signature, u32::MAX);
-                total += b.weight * self.scene.background();
+                out.mix(u32::MAX);
+                out.radiance += b.weight * self.scene.background();
                 continue;
             };
-            signature = mix(signature, index as u32 | b.depth << 16);
+            out.mix(index as u32 | b.depth << 16);
             let material = &self.scene.objects()[index].material;
-            let (local, mut first, mut second) =
-                self.scatter(&b, &hit, material, count, &mut signature);
-            total += local;
+            let (local, mut first, mut second) = self.scatter(&b, &hit, material, count, &mut out);
+            out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
             let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
@@ -339,10 +335,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
             }
         }
-        Sample {
-            radiance: total,
-            signature,
-        }
+        out
     }
 
     /// The caustic store's part at a diffuse point reached by branch `b`: none where
@@ -357,7 +350,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
     }
 
-    /// Light leaving `hit` towards the eye directly, and up to two specular branches.
+    /// Light leaving `hit` towards the eye directly, and up to two specular branches;
+    /// the caustic part and the path's events go to `log`.
     #[inline]
     fn scatter(
         &self,
@@ -365,7 +359,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         hit: &Hit,
         material: &Material,
         count: &mut RayCount,
-        signature: &mut u32,
+        log: &mut Sample,
     ) -> (Rgb, Option<Branch>, Option<Branch>) {
         let d = b.ray.dir;
         let front = hit.front_face(d);
@@ -385,22 +379,21 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !front {
                     return (Rgb::ZERO, None, None);
                 }
-                let mut e = match self.gather_radius(b, hit) {
+                let caustic = match self.gather_radius(b, hit) {
                     Some(r) => self.store.irradiance_within(hit.point, hit.normal, r),
                     None => Rgb::ZERO,
                 };
+                let mut e = caustic;
                 for light in self.scene.lights() {
                     let lit = self.direct_one(hit, light, count);
-                    *signature = mix(*signature, lit.is_some() as u32);
+                    log.mix(lit.is_some() as u32);
                     if let Some((l, irradiance)) = lit {
                         e += irradiance * hit.normal.dot(l.get());
                     }
                 }
-                (
-                    b.weight * m.albedo * e * core::f32::consts::FRAC_1_PI,
-                    None,
-                    None,
-                )
+                let f = b.weight * m.albedo;
+                log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
+                (f * e * core::f32::consts::FRAC_1_PI, None, None)
             }
             Material::Mirror(m) if can_bounce => (
                 Rgb::ZERO,
@@ -423,7 +416,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(b, hit, c, -d, count, signature)
+                    self.classic_local(b, hit, c, -d, count, log)
                 } else {
                     Rgb::ZERO
                 };
@@ -450,14 +443,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         c: &Classic,
         to_eye: UnitVec3,
         count: &mut RayCount,
-        signature: &mut u32,
+        log: &mut Sample,
     ) -> Rgb {
         let n = hit.normal;
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
             let seen = self.direct_one(hit, light, count);
-            *signature = mix(*signature, seen.is_some() as u32);
+            log.mix(seen.is_some() as u32);
             if let Some((l, e)) = seen {
                 lit += c.kernel(n, l, to_eye) * e;
             }
@@ -466,6 +459,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             Some(r) => self.store.classic_within(hit.point, n, to_eye, c, r),
             None => Rgb::ZERO,
         };
+        log.caustic += b.weight * caustic;
         ambient + lit + caustic
     }
 
@@ -498,113 +492,4 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
         Some((l, light.intensity() * (1.0 / d2)))
     }
-
-    /// The average of an `n × n` grid of sub-pixel rays over pixel `(x, y)`.
-    fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> Rgb {
-        let (step, inv) = (1.0 / n as f32, 1.0 / (n * n) as f32);
-        let camera = self.scene.camera();
-        let mut sum = Rgb::ZERO;
-        for sy in 0..n {
-            for sx in 0..n {
-                let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
-                sum += self.radiance(camera.ray_at(x, y, fx, fy), count);
-            }
-        }
-        sum * inv
-    }
-
-    /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
-    #[inline]
-    fn corner(&self, cx: u32, cy: u32, count: &mut RayCount) -> Sample {
-        self.sample(self.scene.camera().ray_at(cx, cy, 0.0, 0.0), count)
-    }
-
-    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width), without the
-    /// splats (see [`with_splats`](Self::with_splats)).
-    pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
-        let mut count = RayCount::default();
-        let camera = self.scene.camera();
-        match self.sampling {
-            Sampling::Centre => {
-                for (x, px) in row.iter_mut().enumerate() {
-                    *px = self.radiance(camera.ray(x as u32, y), &mut count);
-                }
-            }
-            Sampling::Grid(n) => {
-                for (x, px) in row.iter_mut().enumerate() {
-                    *px = self.grid(x as u32, y, n, &mut count);
-                }
-            }
-            Sampling::Adaptive(n) => {
-                // Corners shared along the row: the left pair comes from the pixel before.
-                let mut top = self.corner(0, y, &mut count);
-                let mut bottom = self.corner(0, y + 1, &mut count);
-                for (x, px) in row.iter_mut().enumerate() {
-                    let x = x as u32;
-                    let right_top = self.corner(x + 1, y, &mut count);
-                    let right_bottom = self.corner(x + 1, y + 1, &mut count);
-                    let corners = [top, right_top, bottom, right_bottom];
-                    *px = if agree(&corners) {
-                        corners.iter().fold(Rgb::ZERO, |a, c| a + c.radiance) * 0.25
-                    } else {
-                        count.refined += 1;
-                        self.grid(x, y, n, &mut count)
-                    };
-                    (top, bottom) = (right_top, right_bottom);
-                }
-            }
-        }
-        count
-    }
-
-    /// Renders every row, top to bottom, into the caller's one-row buffer, adds the
-    /// splats that fall in it, and hands each to `sink` before the next is computed: no
-    /// frame buffer. The sink receives exactly `width` pixels (a longer buffer's tail is
-    /// left alone).
-    ///
-    /// An error, before anything is rendered, when `row` is shorter than the image width
-    /// ([`RowsError::Render`] with [`Error::Capacity`]); otherwise stops at the sink's
-    /// first error and returns it ([`RowsError::Sink`]).
-    pub fn rows<E>(
-        &self,
-        row: &mut [Rgb],
-        mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
-    ) -> Result<RayCount, RowsError<E>> {
-        let mut count = RayCount::default();
-        let width = self.scene.camera().width() as usize;
-        let Some(row) = row.get_mut(..width) else {
-            return Err(RowsError::Render(Error::Capacity {
-                what: "row buffer (pixels of one image row)",
-                requested: width,
-                capacity: row.len(),
-            }));
-        };
-        for y in 0..self.scene.camera().height() {
-            count += self.row(y, row);
-            if let Some(splats) = self.splats {
-                add_to_row(splats, y, row);
-            }
-            sink(y, row).map_err(RowsError::Sink)?;
-        }
-        Ok(count)
-    }
-}
-
-/// `true` when four corner samples saw the same things and their luminances are within
-/// [`CONTRAST`] (Mitchell 1987's contrast, on luminance).
-fn agree(c: &[Sample; 4]) -> bool {
-    let s = c[0].signature;
-    if c.iter().any(|x| x.signature != s) {
-        return false;
-    }
-    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
-    for x in c {
-        let l = x.radiance.luminance();
-        if l < lo {
-            lo = l;
-        }
-        hi = crate::math::max(hi, l);
-    }
-    // `!(a > b)` so that NaN never counts as agreement.
-    !(hi - lo > CONTRAST * (hi + lo))
 }
