@@ -335,10 +335,9 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
                     let side = |a: usize| libm::ceilf((m.hi[a] - m.lo[a]) / s).max(1.0);
                     let (w, h) = (side(0), side(1));
                     if !(w <= u32::MAX as f32 && h <= u32::MAX as f32) {
-                        return Err(Error::Capacity {
-                            what: "illumination map texels",
-                            requested: usize::MAX,
-                            capacity: usize::MAX,
+                        return Err(Error::TooLarge {
+                            what: "illumination map side in texels (increase the texel size)",
+                            value: w.max(h),
                         });
                     }
                     m.grids[0] = Grid {
