@@ -219,10 +219,10 @@ fn defaults_are_the_device() {
     let o = Options::parse(Vec::<String>::new()).unwrap().unwrap();
     assert_eq!((o.width, o.height), (W, H));
     assert_eq!(
-        (o.color, o.dither, o.seed),
+        (o.color, o.dither, o.budget.seed),
         (ColorFormat::Rgb565, Dither::Off, 0)
     );
-    assert_eq!((o.scene.as_ref(), o.photons), (None, None));
+    assert_eq!((o.scene.as_ref(), o.budget.count), (None, None));
 }
 
 /// The headline: the simulator's RGB565 pixels are the device's byte stream, bit for bit.
@@ -380,7 +380,7 @@ fn the_command_line_is_checked() {
     .unwrap();
     assert_eq!(o.out, std::path::PathBuf::from("x/y.png"));
     assert_eq!(
-        (o.color, o.seed, o.photons),
+        (o.color, o.budget.seed, o.budget.count),
         (ColorFormat::Rgb888, 9, Some(100))
     );
 }

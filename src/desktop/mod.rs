@@ -5,13 +5,18 @@
 //! among threads, and writes files. Tests, benches and the `caustic` program all come
 //! through here, so they run the very same core as the device.
 
+#[cfg(feature = "cli")]
+#[cfg_attr(docsrs, doc(cfg(feature = "cli")))]
+pub mod cli;
 pub mod image;
 pub mod run;
 pub mod scene_file;
+pub mod settings;
 
 pub use image::Image;
 pub use run::{render, RenderOptions, RenderStats};
 pub use scene_file::{load_scene, parse_scene, LoadedScene, SceneError};
+pub use settings::{SettingsInput, StoreChoice};
 
 use crate::scene::Scene;
 
