@@ -145,7 +145,7 @@ def check_analytic(W, H):
 # ----------------------------------------------------------------------------- noise
 def load_prefix(prefix):
     out = {"full": R.read_pfm(prefix + ".pfm")}
-    for k in ("caustic", "splat", "gather", "direct_seen", "direct_through", "background"):
+    for k in ("caustic", "splat", "gather", "gather2", "direct_seen", "direct_through", "background"):
         f = f"{prefix}.{k}.pfm"
         if os.path.exists(f):
             out[k] = R.read_pfm(f)
@@ -163,6 +163,14 @@ def compare_pair(A, B):
     m2 = bin2(mask[..., None].astype(float))[..., 0] > 0.5
     res["pair_rel_rmse_full_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]))
     res["pair_rel_rmse_caustic_region_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]), m2)
+    if "gather2" in A and "gather2" in B:
+        # kernel bias of the gather: bias(r) ~ D (edges, bias ~ r) or D/3 (smooth, ~ r^2),
+        # D = gather(2r) - gather(r) on the same vertices and photons, mean of both seeds
+        D = 0.5 * ((A["gather2"] - A["gather"]) + (B["gather2"] - B["gather"]))
+        full = 0.5 * (A["full"] + B["full"])
+        res["gather_2r_minus_r_rel_rms_full"] = float(np.sqrt((D ** 2).mean()) / full.mean())
+        res["gather_2r_minus_r_rel_rms_caustic_region"] = float(np.sqrt((D[mask] ** 2).mean()) / full[mask].mean())
+        res["gather_2r_minus_r_rel_sum"] = float(D.sum() / full.sum())
     for k in ("direct_seen", "direct_through", "splat", "gather"):
         if k in A and k in B:
             res[f"sum_{k}"] = float(0.5 * (A[k] + B[k]).sum() / (0.5 * (A["full"] + B["full"])).sum())

@@ -566,7 +566,9 @@ def main(argv=None):
     ap.add_argument("--photons", type=int, default=20_000_000, help="photons emitted per light (into the cones around the specular objects)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--radius", type=float, default=0.0015,
-                    help="disk radius of the gather at diffuse points seen through glass or in a mirror (scene units)")
+                    help="largest disk radius of the gather at diffuse points seen through glass or in a mirror (scene units)")
+    ap.add_argument("--radius-frac", type=float, default=0.05,
+                    help="gather radius = this fraction of the pixel footprint's side at the vertex (at most --radius)")
     ap.add_argument("--spp", type=int, default=64, help="pilot eye samples per pixel (uniform random points)")
     ap.add_argument("--spp-max", type=int, default=4096, help="adaptive cap of eye samples per pixel")
     ap.add_argument("--tol", type=float, default=0.01,
@@ -585,7 +587,7 @@ def main(argv=None):
         return 2
     import pixel
     full, parts, stats, nsamp = pixel.render(scene, args.width, args.height, args.photons, args.seed, args.radius,
-                                             spp=args.spp, spp_max=args.spp_max, tol=args.tol, batch=args.batch)
+                                             radius_frac=args.radius_frac, spp=args.spp, spp_max=args.spp_max, tol=args.tol, batch=args.batch)
     W, H = args.width, args.height
     write_pfm(args.output, full, W, H)
     if args.parts_prefix:
