@@ -43,12 +43,12 @@ def binb(a, b):
     return a[: H // b * b, : W // b * b].reshape(H // b, b, W // b, b, -1).mean(axis=(1, 3))
 
 
-def mitsuba_scene(js, W, H, albedo_scale, max_depth):
+def mitsuba_scene(js, W, H, albedo_scale, max_depth, integrator="ptracer"):
     import mitsuba as mi
     T = mi.ScalarTransform4f
     cam = js["camera"]
     d = {"type": "scene",
-         "integrator": {"type": "ptracer", "max_depth": max_depth, "rr_depth": max_depth + 1,
+         "integrator": {"type": integrator, "max_depth": max_depth, "rr_depth": max_depth + 1,
                         "hide_emitters": True},
          "sensor": {"type": "perspective", "fov": cam["fov_y_deg"], "fov_axis": "y",
                     "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam.get("up", [0, 1, 0])),
@@ -83,9 +83,9 @@ def mitsuba_scene(js, W, H, albedo_scale, max_depth):
     return mi.load_dict(d)
 
 
-def render_pt(js, W, H, scale, spp, seed, max_depth, per_pass=64):
+def render_pt(js, W, H, scale, spp, seed, max_depth, integrator, per_pass=64):
     import mitsuba as mi
-    scene = mitsuba_scene(js, W, H, scale, max_depth)
+    scene = mitsuba_scene(js, W, H, scale, max_depth, integrator)
     acc = np.zeros((H, W, 3))
     n = max(1, spp // per_pass)
     for k in range(n):
@@ -106,6 +106,9 @@ def main(argv):
                     help="Mitsuba max_depth (segments): 10 = L S^8 D E, the contract's longest path seen directly")
     ap.add_argument("--out", default="/tmp/caustic-reference/ptracer")
     ap.add_argument("--json")
+    ap.add_argument("--integrator", choices=("ptracer", "path"), default="ptracer",
+                    help="path: Mitsuba's path tracer, which sees through glass but cannot carry point-light "
+                         "caustics; compared with the reference's direct_seen + direct_through (L D S* E)")
     args = ap.parse_args(argv)
     R.init_mitsuba()
     js = json.load(open(args.scene))
@@ -115,26 +118,29 @@ def main(argv):
     for seed in (1, 2):
         for scale in (1.0, 0.5):
             key = f"s{seed}_a{scale}"
-            path = os.path.join(args.out, f"pt_{key}_{args.spp}.pfm")
+            tag = "pt" if args.integrator == "ptracer" else args.integrator
+            path = os.path.join(args.out, f"{tag}_{key}_{args.spp}.pfm")
             if os.path.exists(path):
                 imgs[key] = R.read_pfm(path)
                 continue
             t0 = time.time()
-            imgs[key] = render_pt(js, W, H, scale, args.spp, seed, args.max_depth)
+            imgs[key] = render_pt(js, W, H, scale, args.spp, seed, args.max_depth, args.integrator)
             times[key] = time.time() - t0
             R.write_pfm(path, imgs[key].reshape(-1, 3), W, H)
             R.log(f"ptracer {key}: {args.spp} spp, {times[key]:.0f}s")
     lin = {s: 4 * imgs[f"s{s}_a0.5"] - imgs[f"s{s}_a1.0"] for s in (1, 2)}
     rho = {s: imgs[f"s{s}_a1.0"] for s in (1, 2)}
-    ref = R.read_pfm(args.ref_prefix + ".direct_seen.pfm") + R.read_pfm(args.ref_prefix + ".splat.pfm")
-    splat = R.read_pfm(args.ref_prefix + ".splat.pfm")
+    other = "splat" if args.integrator == "ptracer" else "direct_through"
+    ref = R.read_pfm(args.ref_prefix + ".direct_seen.pfm") + R.read_pfm(f"{args.ref_prefix}.{other}.pfm")
+    splat = R.read_pfm(f"{args.ref_prefix}.{other}.pfm")
     ref2 = None
     if args.ref2:
-        ref2 = R.read_pfm(args.ref2 + ".direct_seen.pfm") + R.read_pfm(args.ref2 + ".splat.pfm")
-        splat = 0.5 * (splat + R.read_pfm(args.ref2 + ".splat.pfm"))
+        ref2 = R.read_pfm(args.ref2 + ".direct_seen.pfm") + R.read_pfm(f"{args.ref2}.{other}.pfm")
+        splat = 0.5 * (splat + R.read_pfm(f"{args.ref2}.{other}.pfm"))
     refm = ref if ref2 is None else 0.5 * (ref + ref2)
     mask = lum(splat) >= 0.1 * lum(refm)
-    res = dict(spp=args.spp, max_depth=args.max_depth, caustic_px=int(mask.sum()), seconds=times)
+    res = dict(integrator=args.integrator, compared_parts=["direct_seen", other], region=f"{other} >= 10% of the pixel",
+               spp=args.spp, max_depth=args.max_depth, caustic_px=int(mask.sum()), seconds=times)
     for b in (1, 4, 8):
         m = binb(mask[..., None].astype(float), b)[..., 0] > 0.5
         L = {s: binb(lin[s], b) for s in (1, 2)}
@@ -142,7 +148,7 @@ def main(argv):
         Rm = binb(refm, b)
         la, pa = 0.5 * (L[1] + L[2]), 0.5 * (P[1] + P[2])
         row = {}
-        for name, mk in (("full", None), ("caustic", m)):
+        for name, mk in (("full", None), ("region", m)):
             lin_pair = rel_rmse(L[1], L[2], mk)
             r = dict(ptracer_lin_pair=lin_pair, ptracer_rho_pair=rel_rmse(P[1], P[2], mk),
                      ref_vs_lin=rel_rmse(Rm, la, mk), ref_vs_rho=rel_rmse(Rm, pa, mk),

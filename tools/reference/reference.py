@@ -343,15 +343,6 @@ class Camera:
         o = np.repeat(self.pos[None], len(d), axis=0)
         return o, d
 
-    def sample(self, pix, rng):
-        """One ray per entry of pix through an independent uniform random point of that
-        pixel (box filter). rng=None: through the pixel centre (used by the analytic check)."""
-        x = (pix % self.W).astype(np.float64)
-        y = (pix // self.W).astype(np.float64)
-        if rng is None:
-            return self.rays_at(x + 0.5, y + 0.5)
-        return self.rays_at(x + rng.uniform(0, 1, len(pix)), y + rng.uniform(0, 1, len(pix)))
-
     def pixel_area(self):
         return (2 * self.half_w / self.W) * (2 * self.half_h / self.H)
 
@@ -366,6 +357,20 @@ def bounding_sphere(ob):
     if t == "cylinder":
         return ob["base"] + 0.5 * ob["height"] * ob["axis"], math.hypot(ob["radius"], 0.5 * ob["height"])
     return None, None
+
+
+def unit_square(rng, n):
+    """n points in [0,1)^2: an Owen-scrambled Sobol' set (scipy.stats.qmc) drawn from rng.
+    Each point is marginally uniform (so every photon has exactly the pdf its weight
+    assumes: unbiased), and the set is stratified, which lowers the variance of the photon
+    count reaching a pixel where the light's directions map smoothly onto the caustic."""
+    import warnings
+    from scipy.stats import qmc
+    if n == 0:
+        return np.zeros((0, 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # balance warning for n not a power of 2
+        return qmc.Sobol(d=2, scramble=True, seed=rng).random(n)
 
 
 class Emitter:
@@ -399,8 +404,9 @@ class Emitter:
 
     def sample(self, rng, n):
         if self.full:
-            z = rng.uniform(-1, 1, n)
-            phi = rng.uniform(0, 2 * math.pi, n)
+            u = unit_square(rng, n)
+            z = 2 * u[:, 0] - 1
+            phi = 2 * math.pi * u[:, 1]
             s = np.sqrt(1 - z * z)
             d = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
             return d, np.full(n, 4 * math.pi)
@@ -410,8 +416,9 @@ class Emitter:
         for j, (ax, cm, _) in enumerate(self.cones):
             m = k == j
             nm = int(m.sum())
-            cz = 1 - rng.uniform(0, 1, nm) * (1 - cm)
-            phi = rng.uniform(0, 2 * math.pi, nm)
+            u = unit_square(rng, nm)
+            cz = 1 - u[:, 0] * (1 - cm)
+            phi = 2 * math.pi * u[:, 1]
             s = np.sqrt(np.maximum(0, 1 - cz * cz))
             F = frame_z_to(ax)
             d[m] = (np.stack([s * np.cos(phi), s * np.sin(phi), cz], axis=1)) @ F.T
