@@ -1,18 +1,24 @@
 #!/usr/bin/env python3
-"""Validation of the reference against Mitsuba 3's own light tracer (`ptracer`).
+"""Validation of the reference against Mitsuba 3's own integrators (`run --ptracer`).
 
-ptracer cannot see anything through glass or in a mirror from a pinhole (a specular chain
-to a point camera has probability zero), so it estimates exactly the part of the image
-seen directly: L D E and L S+ D E, plus transport the contract leaves out (floor light
-that glass refocuses onto the floor, L D S+ D E, and deeper). With the floor the only
-diffuse surface, the contract's part is linear in the floor albedo rho and the rest is
-O(rho^2): f(rho) = a rho + b rho^2 + c rho^3 + ...  so  4 f(rho/2) - f(rho) = a rho - c rho^3/2.
-This script renders ptracer at rho and rho/2 (each twice, seeds 1 and 2, for its noise)
-and compares that combination with the reference's direct_seen + splat parts.
+`--integrator ptracer` (default): Mitsuba's light tracer cannot see anything through glass or
+in a mirror from a pinhole (a specular chain to a point camera has probability zero), so it
+estimates exactly the part of the image seen directly: L D E and L S+ D E (compared with the
+reference's direct_seen + splat), plus transport the contract leaves out (floor light that
+glass refocuses onto the floor, L D S+ D E, and deeper).
+`--integrator path`: Mitsuba's path tracer sees through glass but cannot carry a point
+light's caustics; its L D S* E is compared with direct_seen + direct_through.
 
-Usage: run ptracer.py SCENE.json REF_PREFIX [--spp N] [--out DIR]
-  REF_PREFIX: a reference render's --parts-prefix (PREFIX.direct_seen.pfm, PREFIX.splat.pfm);
-  a second prefix may follow with --ref2 for the reference's own seed noise.
+With the floor the only diffuse surface, the contract's part is linear in the floor albedo
+rho and the rest is O(rho^2): f(rho) = a rho + b rho^2 + c rho^3 + ...  so
+4 f(rho/2) - f(rho) = a rho - c rho^3 / 2. Both albedos are rendered with the same seed
+(common random numbers; rr_depth > max_depth, so the paths are identical and the rho^2
+term cancels path by path), each at seeds 1 and 2 for the noise. Mitsuba's max_depth
+counts segments: 10 = L S^8 D E, the contract's longest path seen directly.
+
+Usage: run --ptracer SCENE.json REF_PREFIX [--ref2 REF_PREFIX2] [--integrator path] [--spp N]
+  REF_PREFIX: a reference render's --parts-prefix; --ref2 the other seed's (its noise is
+  included in expected_from_noise). Figures per pixel and over 4x4 and 8x8 bins.
 """
 import argparse
 import json
@@ -150,7 +156,7 @@ def main(argv):
         row = {}
         for name, mk in (("full", None), ("region", m)):
             lin_pair = rel_rmse(L[1], L[2], mk)
-            r = dict(ptracer_lin_pair=lin_pair, ptracer_rho_pair=rel_rmse(P[1], P[2], mk),
+            r = dict(mitsuba_lin_pair=lin_pair, mitsuba_rho_pair=rel_rmse(P[1], P[2], mk),
                      ref_vs_lin=rel_rmse(Rm, la, mk), ref_vs_rho=rel_rmse(Rm, pa, mk),
                      sum_lin_over_ref=float(la[mk if mk is not None else ...].sum() / Rm[mk if mk is not None else ...].sum()),
                      sum_rho_over_ref=float(pa[mk if mk is not None else ...].sum() / Rm[mk if mk is not None else ...].sum()))
