@@ -29,10 +29,10 @@ class PhotonMap:
     """All caustic deposits, one kd-tree per diffuse object; irradiance at a point is
     sum_{|x_i - x| < r, same object} Phi_i / (pi r^2)."""
 
-    def __init__(self, deps, radius, frac=0.05, rmin=2e-4):
+    def __init__(self, deps, radius, frac=0.05, rmin=2e-4, kmax=1000):
         from scipy.spatial import cKDTree
         self.cKDTree = cKDTree
-        self.r, self.frac, self.rmin = radius, frac, rmin
+        self.r, self.frac, self.rmin, self.kmax = radius, frac, rmin, kmax
         self.rhist = {}  # gather vertices per radius class
         p = np.concatenate([d[0] for d in deps]) if deps else np.zeros((0, 3))
         obj = np.concatenate([d[1] for d in deps]) if deps else np.zeros(0, np.int64)
@@ -50,6 +50,24 @@ class PhotonMap:
         kmax = np.floor(2 * np.log2(self.r / self.rmin))
         k = np.ceil(2 * np.log2(self.r / np.clip(want, self.rmin, self.r)) - 1e-9)
         return self.r * 2.0 ** (-np.clip(k, 0, kmax) / 2)
+
+    def limit(self, p, obj, radius):
+        """Shrinks the radius (by classes of 1/sqrt 2) where the disk holds more than kmax
+        photons: bounds the cost in a bright focus; a smaller disk only lowers the bias."""
+        radius = radius.copy()
+        for _ in range(16):
+            cnt = np.zeros(len(p), np.int64)
+            for r in np.unique(radius):
+                m = radius == r
+                for i, (tree, _) in self.trees.items():
+                    mi = np.nonzero(m & (obj == i))[0]
+                    if len(mi):
+                        cnt[mi] = tree.query_ball_point(p[mi], r, return_length=True)
+            big = cnt > self.kmax
+            if not big.any():
+                break
+            radius[big] /= math.sqrt(2)
+        return radius
 
     def irradiance(self, p, obj, radius, count=True):
         E = np.zeros((len(p), 3))
@@ -156,7 +174,7 @@ def trace_samples(scene, geo, cam, pix, rng, pmap, fresnel_rng=None):
         si, ww, pp, ob, bb, ns = (np.concatenate([x[k] for x in gv]) for k in range(6))
         if len(si):
             fp = footprint(scene, geo, cam, fx[si], fy[si], bb, ns, ob, pp)
-            r = pmap.radius_for(fp)
+            r = pmap.limit(pp, ob, pmap.radius_for(fp))
             _acc(out["gather"], si, ww * pmap.irradiance(pp, ob, r))
             _acc(out["gather2"], si, ww * pmap.irradiance(pp, ob, 2 * r, count=False))
     return out, rays
