@@ -221,7 +221,7 @@ impl PhotonBuffer {
 
     /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
     /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// [`CHUNK`] and kept in emission order: the same array as the core's
+    /// `CHUNK` and kept in emission order: the same array as the core's
     /// [`photon::shoot`], whatever the thread count.
     pub fn fill<const O: usize, const L: usize>(
         &mut self,
