@@ -457,9 +457,9 @@ impl Progress {
         } else {
             name.into()
         };
-        self.bar.set_prefix(prefix);
-        self.bar.set_length(steps as u64);
         self.bar.reset();
+        self.bar.set_length(steps as u64);
+        self.bar.set_prefix(prefix);
     }
 
     /// One step done.
