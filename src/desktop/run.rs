@@ -37,17 +37,20 @@ pub struct RenderOptions {
     pub alpha: f32,
     /// Eye rays per pixel side (`n × n` per pixel), ≥ 1.
     pub supersample: u32,
-    /// The cap on eye rays per pixel, ≥ 1 (`--max-rays`, `image.max_rays_per_pixel`):
-    /// every branch of a pixel's eye paths counts one ray, and a pixel stops branching
-    /// at the cap (issue 16). `None`: no cap beyond `max_depth`.
+    /// The cap on eye rays per pixel — camera rays and their reflected and refracted
+    /// branches — ≥ 1 (`--max-rays`, `image.max_rays_per_pixel`; issue 16). `None`: no
+    /// cap. Validated by the scene file and the command line; not yet read by
+    /// [`render`].
     pub max_rays_per_pixel: Option<u32>,
-    /// Where to write the per-pixel estimated error as PFM (`--error-map`), if anywhere.
+    /// Where to write the per-pixel estimated error as PFM (`--error-map`; issue 13).
+    /// Not yet read by [`render`].
     pub error_map: Option<PathBuf>,
-    /// Render passes until the estimated relative RMSE is at most this (`--target-error`,
-    /// > 0) instead of a fixed budget; `None`: the fixed budget.
+    /// Render passes until the estimated relative RMSE is at most this, > 0
+    /// (`--target-error`; issue 13), instead of a fixed budget. Not yet read by
+    /// [`render`].
     pub target_error: Option<f32>,
-    /// With `target_error`: stop after this many seconds (`--time-limit`, > 0) even if
-    /// the target is not reached.
+    /// With `target_error`: stop after this many seconds, > 0 (`--time-limit`), even
+    /// if the target is not reached. Not yet read by [`render`].
     pub time_limit: Option<f64>,
 }
 
