@@ -172,9 +172,10 @@ fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress:
     let mut subtrees = vec::Vec::new();
     // Four subtrees per thread, rounded up to a level: balances the load.
     let levels = usize::BITS - (4 * threads - 1).leading_zeros();
+    progress.phase(pass, "balance", 0);
     photon::balance_top(photons, levels, |t| subtrees.push(t));
     subtrees.sort_by_key(|t| t.lo);
-    progress.phase(pass, "balance", subtrees.len());
+    progress.set_steps(subtrees.len());
     // Cut the array into the subtrees' disjoint slices.
     let mut work = vec::Vec::with_capacity(subtrees.len());
     let mut rest = &mut *photons;
@@ -461,8 +462,13 @@ impl Progress {
             name.into()
         };
         self.bar.reset();
-        self.bar.set_length(steps as u64);
         self.bar.set_prefix(prefix);
+        self.bar.set_length(steps as u64);
+    }
+
+    /// The current phase has `steps` steps after all (once they are known).
+    pub fn set_steps(&self, steps: usize) {
+        self.bar.set_length(steps as u64);
     }
 
     /// One step done.
