@@ -290,3 +290,45 @@ fn completions_for_bash_zsh_and_fish() {
     }
     assert_eq!(caustic(&["completions", "tcsh"]).status.code(), Some(2));
 }
+
+/// A flag replaces only its own key: `--photons` on a scene that gathers by radius
+/// renders the bits of the same scene with that `count`, not those of k-nearest.
+#[test]
+fn a_flag_replaces_only_its_key() {
+    let d = dir("override");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scene()).unwrap()).unwrap();
+    // Few photons per estimate, so that the k nearest differ from all within the radius.
+    v["photons"]["k"] = 2.into();
+    let write = |name: &str, count: u32, gather: &str| {
+        let mut v = v.clone();
+        v["photons"]["count"] = count.into();
+        v["photons"]["gather"] = gather.into();
+        let p = d.join(name);
+        std::fs::write(&p, v.to_string()).unwrap();
+        p
+    };
+    let original = write("original.json", 500_000, "radius");
+    let radius = write("radius.json", 5000, "radius");
+    let nearest = write("nearest.json", 5000, "nearest");
+    let render = |sc: &Path, extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "render",
+            s(sc),
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--pfm", s(out)]);
+        let o = caustic(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let flagged = render(&original, &["--photons", "5000"], &d.join("a.pfm"));
+    assert!(flagged == render(&radius, &[], &d.join("b.pfm")));
+    assert!(flagged != render(&nearest, &[], &d.join("c.pfm")));
+    std::fs::remove_dir_all(d).ok();
+}

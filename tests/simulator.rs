@@ -384,3 +384,51 @@ fn the_command_line_is_checked() {
         (ColorFormat::Rgb888, 9, Some(100))
     );
 }
+
+/// `--photons` replaces only the scene file's photon count: its gather choice stays.
+/// With `--photons 20000` the glass sphere (which gathers every photon within its
+/// radius) shows the pixels of the same file with `"count": 20000`, and not those of
+/// the k-nearest gather.
+#[test]
+fn photons_flag_keeps_the_scenes_gather() {
+    let text = std::fs::read_to_string(format!(
+        "{}/scenes/glass_sphere.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("caustic-sim-gather-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // Few photons per estimate, so that the k nearest differ from all in the radius.
+        v["photons"]["k"] = 2.into();
+        edit(&mut v);
+        let path = dir.join(name);
+        std::fs::write(&path, v.to_string()).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let original = file("original.json", &|_| {});
+    let counted = file("counted.json", &|v| v["photons"]["count"] = 20_000.into());
+    let nearest = file("nearest.json", &|v| {
+        v["photons"]["count"] = 20_000.into();
+        v["photons"]["gather"] = "nearest".into();
+    });
+    let show = |args: &[&str]| {
+        let mut all = vec!["--width", "64", "--height", "48", "--scene"];
+        all.extend_from_slice(args);
+        let opts = Options::parse(all.iter().map(|s| s.to_string()))
+            .unwrap()
+            .unwrap();
+        pixels(&simulate::<Rgb565>(&opts))
+    };
+    let flagged = show(&[&original, "--photons", "20000"]);
+    assert!(
+        flagged == show(&[&counted]),
+        "--photons changed more than the count"
+    );
+    assert!(
+        flagged != show(&[&nearest]),
+        "the gather choice makes no difference"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

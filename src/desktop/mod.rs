@@ -1,4 +1,7 @@
-//! The desktop side (feature `std`): scene files, images on disk, threads and progress.
+//! The desktop side (feature `std`): scene files ([`scene_file`]) and the settings
+//! they share with the command line ([`settings`], one validation for both), images on
+//! disk ([`image`]: PNG, PFM, OpenEXR), threads and progress ([`run`]), and with
+//! feature `cli` the command-line arguments of `caustic` and the examples ([`cli`]).
 //!
 //! It is thin on purpose: everything that decides a pixel's value lives in the no_std
 //! core; this module reads files, allocates the photon array on the heap, splits rows

@@ -42,13 +42,15 @@ pub struct RenderOptions {
     /// every branch of a pixel's eye paths counts one ray, and a pixel stops branching
     /// at the cap (issue 16). `None`: no cap beyond `max_depth`.
     pub max_rays_per_pixel: Option<u32>,
-    /// Where to write the per-pixel estimated error as PFM (`--error-map`), if anywhere.
+    /// Where to write the per-pixel estimated error as PFM (`--error-map`; issue 13).
+    /// Not yet read by [`render`].
     pub error_map: Option<PathBuf>,
-    /// Render passes until the estimated relative RMSE is at most this (`--target-error`,
-    /// > 0) instead of a fixed budget; `None`: the fixed budget.
+    /// Render passes until the estimated relative RMSE is at most this, > 0
+    /// (`--target-error`; issue 13), instead of a fixed budget. Not yet read by
+    /// [`render`].
     pub target_error: Option<f32>,
-    /// With `target_error`: stop after this many seconds (`--time-limit`, > 0) even if
-    /// the target is not reached.
+    /// With `target_error`: stop after this many seconds, > 0 (`--time-limit`), even
+    /// if the target is not reached. Not yet read by [`render`].
     pub time_limit: Option<f64>,
 }
 
@@ -173,9 +175,10 @@ fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress:
     let mut subtrees = vec::Vec::new();
     // Four subtrees per thread, rounded up to a level: balances the load.
     let levels = usize::BITS - (4 * threads - 1).leading_zeros();
+    progress.phase(pass, "balance", 0);
     photon::balance_top(photons, levels, |t| subtrees.push(t));
     subtrees.sort_by_key(|t| t.lo);
-    progress.phase(pass, "balance", subtrees.len());
+    progress.set_steps(subtrees.len());
     // Cut the array into the subtrees' disjoint slices.
     let mut work = vec::Vec::with_capacity(subtrees.len());
     let mut rest = &mut *photons;
@@ -226,7 +229,7 @@ impl PhotonBuffer {
 
     /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
     /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// [`CHUNK`] and kept in emission order: the same array as the core's
+    /// `CHUNK` and kept in emission order: the same array as the core's
     /// [`photon::shoot`], whatever the thread count.
     pub fn fill<const O: usize, const L: usize>(
         &mut self,
@@ -493,9 +496,14 @@ impl Progress {
         } else {
             name.into()
         };
+        self.bar.reset();
         self.bar.set_prefix(prefix);
         self.bar.set_length(steps as u64);
-        self.bar.reset();
+    }
+
+    /// The current phase has `steps` steps after all (once they are known).
+    pub fn set_steps(&self, steps: usize) {
+        self.bar.set_length(steps as u64);
     }
 
     /// One step done.

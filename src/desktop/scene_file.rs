@@ -579,3 +579,63 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         .map_err(|e| err("", format!("cannot read {}: {e}", path.display())))?;
     parse_scene(&text)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The labels in the tables are the ones the core emits: a value the core rejects
+    /// lands at its own field's path (a renamed label would land at the object's).
+    #[test]
+    fn each_core_label_maps_to_its_field() {
+        let scene = |camera: &str, light: &str, object: &str| {
+            format!(
+                r#"{{"camera": {{"position": {camera}, "look_at": [0, 0, 0], "fov_y_deg": 40}},
+                "lights": [{{"type": "point", "position": {light}, "intensity": [1, 1, 1]}}],
+                "materials": {{"m": {{"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}}},
+                "objects": [{object}]}}"#
+            )
+        };
+        let (cam, light, big) = ("[0, 1, 5]", "[0, 5, 0]", "[1e300, 0, 0]");
+        let sphere = r#"{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}"#;
+        let cases = [
+            (scene(big, light, sphere), "camera.position"),
+            (scene(cam, big, sphere), "lights[0].position"),
+            (
+                r#"{"type": "plane", "point": [1e300, 0, 0], "normal": [0, 1, 0], "material": "m"}"#
+                    .to_string(),
+                "objects[0].point",
+            ),
+            (sphere.replace("[0, 0, 0]", big), "objects[0].center"),
+            (
+                r#"{"type": "box", "center": [0, 0, 0], "size": [1, 1, 1], "rotation_deg": [1e300, 0, 0], "material": "m"}"#
+                    .to_string(),
+                "objects[0].rotation_deg",
+            ),
+            (
+                r#"{"type": "box", "center": [1e300, 0, 0], "size": [1, 1, 1], "material": "m"}"#
+                    .to_string(),
+                "objects[0].center",
+            ),
+            (cylinder("[1e300, 0, 0]", "1", "1"), "objects[0].base"),
+            (cylinder("[0, 0, 0]", "0", "1"), "objects[0].radius"),
+            (cylinder("[0, 0, 0]", "1", "0"), "objects[0].height"),
+        ];
+        for (i, (text, path)) in cases.into_iter().enumerate() {
+            let text = if text.starts_with("{\"camera") {
+                text
+            } else {
+                scene(cam, light, &text)
+            };
+            let e = parse_scene(&text).expect_err(path);
+            assert_eq!(e.path, path, "case {i}: {e}");
+        }
+    }
+
+    fn cylinder(base: &str, radius: &str, height: &str) -> String {
+        format!(
+            r#"{{"type": "cylinder", "base": {base}, "axis": [0, 1, 0], "radius": {radius},
+            "height": {height}, "material": "m"}}"#
+        )
+    }
+}

@@ -455,97 +455,37 @@ mod tests {
     /// location differs.
     #[test]
     fn a_flag_and_a_key_get_the_same_message() {
-        type Set = fn(&mut SettingsInput, Source);
-        let cases: [(Set, &str); 9] = [
-            (
-                |s, src| {
-                    s.passes = Some(Given {
-                        value: 0,
-                        source: src,
-                    })
-                },
-                "passes",
-            ),
-            (
-                |s, src| {
-                    s.k = Some(Given {
-                        value: 0,
-                        source: src,
-                    })
-                },
-                "k",
-            ),
-            (
-                |s, src| {
-                    s.k = Some(Given {
-                        value: 5000,
-                        source: src,
-                    })
-                },
-                "k",
-            ),
-            (
-                |s, src| {
-                    s.max_depth = Some(Given {
-                        value: 40,
-                        source: src,
-                    })
-                },
-                "depth",
-            ),
-            (
-                |s, src| {
-                    s.max_depth = Some(Given {
-                        value: 999,
-                        source: src,
-                    })
-                },
-                "depth",
-            ),
-            (
-                |s, src| {
-                    s.max_radius = Some(Given {
-                        value: -1.0,
-                        source: src,
-                    })
-                },
-                "radius",
-            ),
-            (
-                |s, src| {
-                    s.alpha = Some(Given {
-                        value: 1.0,
-                        source: src,
-                    })
-                },
-                "alpha",
-            ),
-            (
-                |s, src| {
-                    s.width = Some(Given {
-                        value: 0,
-                        source: src,
-                    })
-                },
-                "width",
-            ),
-            (
-                |s, src| {
-                    s.max_rays = Some(Given {
-                        value: 0,
-                        source: src,
-                    })
-                },
-                "rays",
-            ),
+        fn g<T>(value: T, source: Source) -> Option<Given<T>> {
+            Some(Given { value, source })
+        }
+        let cases: [fn(&mut SettingsInput, Source); 9] = [
+            |s, src| s.passes = g(0, src),
+            |s, src| s.k = g(0, src),
+            |s, src| s.k = g(5000, src),
+            |s, src| s.max_depth = g(40, src),
+            |s, src| s.max_depth = g(999, src),
+            |s, src| {
+                s.max_radius = Some(Given {
+                    value: -1.0,
+                    source: src,
+                })
+            },
+            |s, src| {
+                s.alpha = Some(Given {
+                    value: 1.0,
+                    source: src,
+                })
+            },
+            |s, src| s.width = g(0, src),
+            |s, src| s.max_rays = g(0, src),
         ];
-        for (set, name) in cases {
+        for (i, set) in cases.into_iter().enumerate() {
             let (mut file, mut flag) = (SettingsInput::default(), SettingsInput::default());
             set(&mut file, Source::File);
             set(&mut flag, Source::Flag);
-            let a = file.validate(&scene()).expect_err(name);
-            let b = flag.validate(&scene()).expect_err(name);
-            assert_eq!(a.message, b.message, "{name}");
+            let a = file.validate(&scene()).expect_err("file");
+            let b = flag.validate(&scene()).expect_err("flag");
+            assert_eq!(a.message, b.message, "case {i}");
             assert!(
                 a.path.contains('.') && b.path.starts_with("--"),
                 "{a} / {b}"

@@ -7,6 +7,7 @@ mod display;
 mod srgb_table;
 
 #[cfg(feature = "embedded-graphics")]
+#[cfg_attr(docsrs, doc(cfg(feature = "embedded-graphics")))]
 pub use display::{DisplaySink, Dither};
 
 use crate::error::{positive, Error};
