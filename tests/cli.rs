@@ -169,11 +169,11 @@ fn bad_flag_values_name_the_flag_and_match_the_files_message() {
     let o = small_render(&["--threads", "0", "-o", s(&d.join("x.png"))]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--threads"), "{}", stderr(&o));
-    v["image"]["max_rays_per_pixel"] = serde_json::json!(0);
+    v["image"]["max_rays_per_sample"] = serde_json::json!(0);
     let file = d.join("rays.json");
     std::fs::write(&file, v.to_string()).unwrap();
     let o = caustic(&["render", s(&file), "-o", s(&d.join("x.png"))]);
-    assert!(stderr(&o).contains("image.max_rays_per_pixel: must be at least 1"));
+    assert!(stderr(&o).contains("image.max_rays_per_sample: must be at least 1"));
     let o = small_render(&["--max-rays", "0", "-o", s(&d.join("x.png"))]);
     assert!(stderr(&o).contains("--max-rays: must be at least 1"));
     std::fs::remove_dir_all(d).ok();

@@ -162,7 +162,7 @@ pub struct RenderArgs {
     /// Texel side of the illumination maps, scene units [default: the scene's texel_size, else 0.05]
     #[arg(long, value_name = "S")]
     pub texel_size: Option<f32>,
-    /// Cap on eye rays per pixel, ≥ 1 [default: the scene's image.max_rays_per_pixel, else none]
+    /// Cap on rays (eye and shadow) per camera ray, ≥ 2 [default: the scene's image.max_rays_per_sample, else 256]
     #[arg(long, value_name = "N")]
     pub max_rays: Option<u32>,
     /// How each pixel's area is sampled
@@ -224,7 +224,7 @@ impl RenderArgs {
                 SamplingArg::Centre => Sampling::Centre,
                 SamplingArg::Grid => Sampling::Grid(self.supersample),
             },
-            max_rays_per_pixel: loaded.max_rays_per_pixel,
+            max_rays_per_sample: loaded.max_rays_per_sample,
             error_map: self.error_map.clone(),
             target_error: self.target_error,
             time_limit: self.time_limit,

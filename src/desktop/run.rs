@@ -38,10 +38,10 @@ pub struct RenderOptions {
     pub alpha: f32,
     /// How each pixel's area is sampled (default: adaptive, corners then a 4 × 4 grid).
     pub sampling: Sampling,
-    /// The cap on eye rays per pixel, ≥ 1 (`--max-rays`, `image.max_rays_per_pixel`):
-    /// every branch of a pixel's eye paths counts one ray, and a pixel stops branching
-    /// at the cap (issue 16). `None`: no cap beyond `max_depth`.
-    pub max_rays_per_pixel: Option<u32>,
+    /// The cap on rays (eye and shadow) per camera ray (`--max-rays`,
+    /// `image.max_rays_per_sample`; issue 16): see [`Renderer::with_ray_budget`].
+    /// `None`: [`DEFAULT_RAY_BUDGET`](crate::render::DEFAULT_RAY_BUDGET).
+    pub max_rays_per_sample: Option<u32>,
     /// Where to write the per-pixel estimated error as PFM (`--error-map`; issue 13).
     /// Not yet read by [`render`].
     pub error_map: Option<PathBuf>,
@@ -63,7 +63,7 @@ impl Default for RenderOptions {
             passes: 1,
             alpha: 2.0 / 3.0,
             sampling: Sampling::Adaptive(REFINE),
-            max_rays_per_pixel: None,
+            max_rays_per_sample: None,
             error_map: None,
             target_error: None,
             time_limit: None,
@@ -421,6 +421,9 @@ fn backward_pass<S: CausticStore + Sync>(
         Renderer::new(scene, &timed, settings.max_depth())?
             .with_sampling(opts.sampling)?
             .with_footprint_scale(shrink);
+    if let Some(budget) = opts.max_rays_per_sample {
+        renderer = renderer.with_ray_budget(budget)?;
+    }
     if let Some(splats) = splats {
         renderer = renderer.with_splats(splats);
     }

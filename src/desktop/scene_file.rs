@@ -115,7 +115,7 @@ struct CameraDef {
 struct ImageDef {
     width: u32,
     height: u32,
-    max_rays_per_pixel: Option<u32>,
+    max_rays_per_sample: Option<u32>,
 }
 
 /// The scene's `photons` block, all optional.
@@ -247,8 +247,8 @@ pub struct LoadedScene {
     pub alpha: f32,
     /// The caustic store (`photons.caustic_store`), default the kd-tree.
     pub caustic_store: StoreChoice,
-    /// The cap on eye rays per pixel (`image.max_rays_per_pixel`), if any.
-    pub max_rays_per_pixel: Option<u32>,
+    /// The cap on rays per camera ray (`image.max_rays_per_sample`), if any.
+    pub max_rays_per_sample: Option<u32>,
     /// The file's shared settings as written, for flags to override
     /// ([`LoadedScene::with_overrides`]).
     pub input: SettingsInput,
@@ -266,7 +266,7 @@ impl LoadedScene {
         self.passes = s.passes;
         self.alpha = s.alpha;
         self.caustic_store = s.caustic_store;
-        self.max_rays_per_pixel = s.max_rays_per_pixel;
+        self.max_rays_per_sample = s.max_rays_per_sample;
         Ok(self)
     }
 }
@@ -320,7 +320,7 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
         passes: settings.passes,
         alpha: settings.alpha,
         caustic_store: settings.caustic_store,
-        max_rays_per_pixel: settings.max_rays_per_pixel,
+        max_rays_per_sample: settings.max_rays_per_sample,
         input,
     })
 }
@@ -540,7 +540,7 @@ fn settings_input(image: Option<&ImageDef>, p: PhotonsDef) -> Result<SettingsInp
         gather: gather.map(Given::file),
         store: store.map(Given::file),
         texel_size: texel_size.map(Given::file),
-        max_rays: image.and_then(|i| i.max_rays_per_pixel).map(Given::file),
+        max_rays: image.and_then(|i| i.max_rays_per_sample).map(Given::file),
     })
 }
 

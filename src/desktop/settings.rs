@@ -43,7 +43,7 @@ pub enum Key {
     Store,
     /// `photons.caustic_store.texel_size`, `--texel-size`.
     TexelSize,
-    /// `image.max_rays_per_pixel`, `--max-rays`.
+    /// `image.max_rays_per_sample`, `--max-rays`.
     MaxRays,
 }
 
@@ -62,7 +62,7 @@ impl Key {
             Key::Gather => "photons.gather",
             Key::Store => "photons.caustic_store.type",
             Key::TexelSize => "photons.caustic_store.texel_size",
-            Key::MaxRays => "image.max_rays_per_pixel",
+            Key::MaxRays => "image.max_rays_per_sample",
         }
     }
 
@@ -228,7 +228,7 @@ pub struct SettingsInput {
     pub store: Option<Given<StoreKind>>,
     /// The illumination maps' texel side.
     pub texel_size: Option<Given<f32>>,
-    /// The cap on eye rays per pixel.
+    /// The cap on rays per camera ray.
     pub max_rays: Option<Given<u32>>,
 }
 
@@ -245,8 +245,8 @@ pub struct Settings {
     pub alpha: f32,
     /// The caustic store.
     pub caustic_store: StoreChoice,
-    /// The cap on eye rays per pixel, ≥ 1, if any.
-    pub max_rays_per_pixel: Option<u32>,
+    /// The cap on rays (eye and shadow) per camera ray, if any.
+    pub max_rays_per_sample: Option<u32>,
 }
 
 impl SettingsInput {
@@ -299,7 +299,7 @@ impl SettingsInput {
             passes: self.passes()?,
             alpha: self.alpha()?,
             caustic_store: self.store()?,
-            max_rays_per_pixel: self.max_rays()?,
+            max_rays_per_sample: self.max_rays()?,
         })
     }
 

@@ -45,7 +45,9 @@
 //!   noise, which an image that must match a reference to 1e-3 cannot afford; the
 //!   fixed threshold biases by a bounded, measured amount (see [`DEFAULT_CUTOFF`]).
 //! - **ray budget** ([`Renderer::with_ray_budget`], default [`DEFAULT_RAY_BUDGET`]):
-//!   at most that many rays (eye and shadow) per pixel. An eye ray is traced only when
+//!   at most that many rays (eye and shadow) per camera ray, so a pixel spends at most
+//!   its samples (one, `n²`, or for [`Sampling::Adaptive`] at most `21n² + 4`) times
+//!   that. An eye ray is traced only when
 //!   the rays already spent plus it and the shadow rays it may need (one per lit light)
 //!   stay within the budget; once one does not fit, every pending branch is dropped.
 //!   At each fork the heavier branch (larger channel sum) is followed first and the
@@ -68,7 +70,7 @@ mod pixels;
 
 use crate::scene::Scene;
 pub use estimate::{ErrorTally, PixelEstimate};
-pub use pixels::{Sampling, CONTRAST, REFINE};
+pub use pixels::{Sampling, CONTRAST, REFINE, REFINE_TOLERANCE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -77,12 +79,13 @@ pub use pixels::{Sampling, CONTRAST, REFINE};
 /// reflections), 1e-4 leaves out 3e-5 and still skips a quarter of the eye rays.
 pub const DEFAULT_CUTOFF: f32 = 1e-4;
 
-/// The default budget of rays (eye and shadow) per pixel, the same on every target (the
-/// device states it at compile time here): see [`Renderer::with_ray_budget`].
+/// The default budget of rays (eye and shadow) per camera ray, the same on every target
+/// (the device states it at compile time here): see [`Renderer::with_ray_budget`].
 /// It binds on trees built to branch (classic surfaces both reflective and
 /// transparent, deep `max_depth`); the glass sphere at 64×48 spends 1.7 eye rays a
-/// pixel on average.
-pub const DEFAULT_RAY_BUDGET: u32 = 4096;
+/// pixel on average, and a path through it that totally reflects inside needs a few
+/// dozen (at 16 such paths lost a focus seen through the glass).
+pub const DEFAULT_RAY_BUDGET: u32 = 256;
 
 /// Why [`Renderer::rows`] stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -218,16 +221,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         Ok(self)
     }
 
-    /// At most `max_rays` rays (eye and shadow) per pixel; default
-    /// [`DEFAULT_RAY_BUDGET`]. With `n × n` supersampling each sample gets
-    /// `⌊max_rays / n²⌋` (`⌊max_rays / (n² + 4)⌋` adaptive, which may also trace the
-    /// pixel's four corners), but never less than one eye ray and its shadow rays
-    /// (`1 + lit lights`). An error when `max_rays` is below `1 + lit lights`: the
-    /// camera ray of a pixel could not be shaded.
+    /// At most `max_rays` rays (eye and shadow) per camera ray; default
+    /// [`DEFAULT_RAY_BUDGET`]. An error when `max_rays` is below `1 + lit lights`: the
+    /// camera ray could not be shaded.
     pub fn with_ray_budget(mut self, max_rays: u32) -> Result<Self, Error> {
         if max_rays < self.rays_per_hit {
             return Err(Error::OutOfRange {
-                what: "image.max_rays_per_pixel",
+                what: "image.max_rays_per_sample",
                 value: max_rays as f32,
                 min: self.rays_per_hit as f32,
                 max: u32::MAX as f32,
@@ -235,17 +235,6 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
         self.ray_budget = max_rays;
         Ok(self)
-    }
-
-    /// The rays one eye sample may spend.
-    fn sample_budget(&self) -> u64 {
-        // Samples a pixel may trace: its grid, and for the adaptive scheme its corners.
-        let n2 = match self.sampling {
-            Sampling::Centre => 1,
-            Sampling::Grid(n) => n as u64 * n as u64,
-            Sampling::Adaptive(n) => n as u64 * n as u64 + 4,
-        };
-        (self.ray_budget as u64 / n2).max(self.rays_per_hit as u64)
     }
 
     /// The caustics seen directly come from these splats of the forward pass (in
@@ -291,8 +280,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         self.scene
     }
 
-    /// Radiance arriving at the origin of `ray` along it, spending at most one sample's
-    /// share of the ray budget (see the [module documentation](self)).
+    /// Radiance arriving at the origin of `ray` along it, spending at most the ray
+    /// budget (see the [module documentation](self)).
     pub fn radiance(&self, ray: Ray, count: &mut RayCount) -> Rgb {
         self.sample(ray, count).radiance
     }
@@ -307,7 +296,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             depth: 0,
             travelled: 0.0,
         });
-        let limit = count.eye + count.shadow + self.sample_budget();
+        let limit = count.eye + count.shadow + self.ray_budget as u64;
         while let Some(b) = next.take().or_else(|| stack.pop()) {
             if count.eye + count.shadow + self.rays_per_hit as u64 > limit {
                 break; // the budget is spent: drop this and every pending branch

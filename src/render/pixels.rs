@@ -31,6 +31,11 @@ pub const CONTRAST: f32 = 0.04;
 /// The default sub-pixel grid side of [`Sampling::Adaptive`].
 pub const REFINE: u32 = 4;
 
+/// [`Sampling::Adaptive`] refines a supersampled pixel further — its grid side doubled,
+/// at most twice — while the grid's own error estimate exceeds this fraction of the
+/// pixel's brightness (the brighter of its value and its brightest corner).
+pub const REFINE_TOLERANCE: f32 = 0.01;
+
 impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     Renderer<'_, S, O, L, DEPTH>
 {
@@ -65,6 +70,24 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             split: Rgb::ZERO,
             sampling2,
         }
+    }
+
+    /// Pixel `(x, y)` on an `n × n` grid, then `2n × 2n` and `4n × 4n` while the
+    /// grid's error estimate exceeds [`REFINE_TOLERANCE`] of the brighter of the
+    /// pixel's value and `bright` (a focus seen through glass needs hundreds of rays).
+    fn refine(&self, x: u32, y: u32, n: u32, bright: f32, count: &mut RayCount) -> PixelEstimate {
+        let mut p = self.grid(x, y, n, count);
+        let mut m = n;
+        while m < 4 * n && m <= 32 {
+            let e = p.sampling2.luminance();
+            let scale = crate::math::max(p.radiance.luminance(), bright) * REFINE_TOLERANCE;
+            if !(e > scale * scale) {
+                break;
+            }
+            m *= 2;
+            p = self.grid(x, y, m, count);
+        }
+        p
     }
 
     /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
@@ -119,7 +142,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                             }
                         } else {
                             count.refined += 1;
-                            self.grid(x as u32, y, n, &mut count)
+                            let bright =
+                                c.iter().map(|s| s.radiance.luminance()).fold(0.0, f32::max);
+                            self.refine(x as u32, y, n, bright, &mut count)
                         },
                     );
                     (top, bottom) = (right_top, right_bottom);
