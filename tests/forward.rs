@@ -9,7 +9,9 @@ use caustic::geometry::Shape;
 use caustic::light::PointLight;
 use caustic::material::{interface, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
-use caustic::photon::{self, balance, store_over, CausticStore, KdTree, Photon, PhotonSettings};
+use caustic::photon::{
+    self, balance, store_over, CausticStore, KdTree, NoCaustics, Photon, PhotonSettings,
+};
 use caustic::render::Renderer;
 use caustic::scene::Scene;
 
@@ -142,16 +144,25 @@ fn flux_through_a_glass_slab_matches_fresnel_transmission() {
     assert!(stored < 4.0 * PI * intensity as f64);
 }
 
-/// The caustic term alone, as an image (direct light off), so that images compare
-/// the forward pass only.
+/// The caustic term alone, as an image: the render with the photon store minus the
+/// render of the same eye paths with no caustic store (direct light, which both
+/// contain bit for bit, cancels), so that images compare the forward pass only.
 fn caustic_image(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> (Image, u64) {
     let (map, unit, emitted) = photons(scene, settings, seed);
     let store = store_over::<1024>(KdTree::from_balanced(&map), unit, settings).unwrap();
-    let cam = scene.camera();
-    let mut img = Image::new(cam.width(), cam.height());
-    let r: Renderer<_, 64, 16, 32> = Renderer::new(scene, &store, settings.max_depth()).unwrap();
-    for (y, row) in img.pixels.chunks_mut(cam.width() as usize).enumerate() {
-        r.row(y as u32, row);
+    fn draw<S: CausticStore>(scene: &DesktopScene, store: &S, depth: u32) -> Image {
+        let cam = scene.camera();
+        let mut img = Image::new(cam.width(), cam.height());
+        let r: Renderer<_, 64, 16, 32> = Renderer::new(scene, store, depth).unwrap();
+        for (y, row) in img.pixels.chunks_mut(cam.width() as usize).enumerate() {
+            r.row(y as u32, row);
+        }
+        img
+    }
+    let depth = settings.max_depth();
+    let (mut img, direct) = (draw(scene, &store, depth), draw(scene, &NoCaustics, depth));
+    for (p, d) in img.pixels.iter_mut().zip(&direct.pixels) {
+        *p += *d * -1.0;
     }
     (img, emitted)
 }

@@ -8,12 +8,15 @@
 //! (the random-scene count; default 300). See `docs/stability.md`.
 
 use caustic::camera::Camera;
+use caustic::desktop::run::{render_rows, Progress};
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
+use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Hit, Ray, Shape};
 use caustic::light::PointLight;
 use caustic::material::{interface, Classic, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
-use caustic::photon::{self, Photon, PhotonSettings};
+use caustic::photon::{self, NoCaustics, Photon, PhotonSettings};
+use caustic::render::Renderer;
 use proptest::prelude::*;
 use serde_json::Value;
 
@@ -1100,20 +1103,43 @@ fn a_zero_power_light() {
     )
     .unwrap();
     assert!(image.pixels.iter().all(|p| *p == Rgb::ZERO));
-    // A dark light beside a bright one changes nothing.
-    scene
-        .add_light(PointLight::new(Vec3::new(2.0, 5.0, 0.0), Rgb::splat(50.0)).unwrap())
-        .unwrap();
+    // A dark light beside a bright one changes nothing: wherever it is, the image is
+    // the same bits; only the bright light emits; and direct light alone (no caustic
+    // store) is the bits of the scene without the dark light, at the same ray count.
+    let bright = PointLight::new(Vec3::new(2.0, 5.0, 0.0), Rgb::splat(50.0)).unwrap();
+    let opts = RenderOptions {
+        threads: 1,
+        ..RenderOptions::default()
+    };
+    scene.add_light(bright).unwrap();
     let f = photon::shoot(&scene, &settings, 0, 0, &mut vec![Photon::ZERO; 2000]).unwrap();
     assert!(f.stored > 0 && f.power_unit.is_finite());
-    let (image, _) = render(
-        &scene,
-        &settings,
-        &RenderOptions {
-            threads: 1,
-            ..RenderOptions::default()
-        },
-    )
-    .unwrap();
+    assert_eq!(f.emitted, settings.count() as u64);
+    let (image, stats) = render(&scene, &settings, &opts).unwrap();
     assert!(image.pixels.iter().all(|p| p.is_finite()));
+    assert!(image.pixels.iter().any(|p| p.g > 0.0));
+    let mut moved = DesktopScene::new(*scene.camera());
+    for o in scene.objects() {
+        moved.add(o.shape, o.material).unwrap();
+    }
+    // The dark light inside the glass sphere now.
+    moved
+        .add_light(PointLight::new(Vec3::new(0.0, 1.0, 0.0), Rgb::ZERO).unwrap())
+        .unwrap();
+    moved.add_light(bright).unwrap();
+    let (image2, stats2) = render(&moved, &settings, &opts).unwrap();
+    assert!(image.pixels == image2.pixels && stats.rays == stats2.rays);
+    let mut alone = DesktopScene::new(*scene.camera());
+    for o in scene.objects() {
+        alone.add(o.shape, o.material).unwrap();
+    }
+    alone.add_light(bright).unwrap();
+    let direct = |sc: &DesktopScene| {
+        let r: Renderer<'_, _, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+            Renderer::new(sc, &NoCaustics, settings.max_depth()).unwrap();
+        let mut img = caustic::desktop::Image::new(16, 12);
+        let rays = render_rows(&r, &mut img, 1, &Progress::new(false, 0));
+        (img.pixels, rays)
+    };
+    assert_eq!(direct(&scene), direct(&alone));
 }
