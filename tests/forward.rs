@@ -1,6 +1,8 @@
 //! The forward pass against analytic answers: photon density, energy through glass,
 //! and projection maps against full-sphere emission.
 
+mod support;
+
 use std::f64::consts::PI;
 
 use caustic::camera::Camera;
@@ -14,6 +16,7 @@ use caustic::photon::{
 };
 use caustic::render::Renderer;
 use caustic::scene::Scene;
+use support::scene_text;
 
 /// Shoots, balances and returns the photons and their power unit.
 fn photons<const O: usize, const L: usize>(
@@ -172,11 +175,7 @@ fn caustic_image(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> 
 /// the objects, to within the noise between two seeds, for a fraction of the photons.
 #[test]
 fn projection_maps_match_full_sphere_emission_for_a_fraction_of_the_work() {
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/glass_sphere.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = scene_text("glass_sphere.json");
     let loaded = parse_scene(&text).unwrap();
     let mut scene = loaded.scene;
     // Only the caustic: light the floor with nothing else (a dark light would emit no
@@ -255,11 +254,7 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
 #[test]
 fn the_parallel_forward_pass_is_the_serial_one() {
     use caustic::desktop::run::{PhotonBuffer, RenderStats};
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/two_balls.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = scene_text("two_balls.json");
     let scene = parse_scene(&text).unwrap().scene;
     // Enough photons that the balance runs in parallel too (above 2^15 stored).
     let s = PhotonSettings::new(60_000, 16, 0.1, 8).unwrap();

@@ -2,6 +2,8 @@
 //! from uniform flux, energy conservation, true texel areas, the single-photon round
 //! trip, determinism, and the streaming forward pass against `shoot`.
 
+mod support;
+
 use std::f64::consts::PI;
 
 use caustic::camera::Camera;
@@ -15,6 +17,7 @@ use caustic::photon::{
     PhotonSettings,
 };
 use caustic::scene::Scene;
+use support::{data_text, scene_text};
 
 type Maps = IlluminationMaps<Vec<Rgb>, 8>;
 
@@ -131,7 +134,7 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
 /// splatted + dropped equals what the forward pass stored, on a real caustic scene.
 #[test]
 fn total_energy_equals_the_energy_splatted() {
-    let text = std::fs::read_to_string("scenes/glass_sphere.json").unwrap();
+    let text = scene_text("glass_sphere.json");
     let loaded = parse_scene(&text).unwrap();
     let settings = PhotonSettings::new(20_000, 32, 0.1, 8).unwrap();
     let mut maps = IlluminationMaps::<Vec<Rgb>, 64>::new(Vec::new(), 0.05).unwrap();
@@ -301,7 +304,7 @@ fn single_photon_round_trip_conserves_energy() {
 /// array holds the same maps as a `Vec`.
 #[test]
 fn same_seed_same_bits_and_streaming_equals_stored() {
-    let text = std::fs::read_to_string("scenes/tube.json").unwrap();
+    let text = scene_text("tube.json");
     let loaded = parse_scene(&text).unwrap();
     let scene = &loaded.scene;
     let settings = PhotonSettings::new(5_000, 32, 0.1, 8).unwrap();
@@ -383,11 +386,7 @@ fn photons_from_behind_are_not_splatted() {
 /// budget, and a budget below one texel a chart is an error, not a truncation.
 #[test]
 fn a_layout_beyond_the_texel_budget_is_coarsened_to_fit() {
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/two_balls.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = scene_text("two_balls.json");
     let scene = caustic::desktop::parse_scene(&text).unwrap().scene;
     let settings = PhotonSettings::new(20_000, 16, 0.02, 8).unwrap();
     for budget in [100_000usize, 5_000, 64] {
@@ -436,11 +435,7 @@ fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     use caustic::desktop::{RenderStats, MAX_GATHER, MAX_OBJECTS};
     use caustic::photon::DEFAULT_HEAP_TEXELS;
 
-    let text = std::fs::read_to_string(format!(
-        "{}/tests/data/glass_sphere_wall.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = data_text("glass_sphere_wall.json");
     let loaded = parse_scene(&text).unwrap();
     let texel = match loaded.caustic_store {
         caustic::desktop::scene_file::StoreChoice::IlluminationMap { texel_size } => texel_size,

@@ -1,6 +1,8 @@
 //! The backward pass end to end: analytic radiance, refraction geometry, determinism
 //! across threads, and the scene files' error messages.
 
+mod support;
+
 use caustic::camera::Camera;
 use caustic::desktop::image::compare;
 use caustic::desktop::run::{render_rows, PhotonBuffer, Progress};
@@ -15,10 +17,7 @@ use caustic::photon;
 use caustic::photon::{NoCaustics, PhotonSettings};
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
-
-fn read(name: &str) -> String {
-    std::fs::read_to_string(format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
-}
+use support::scene_text;
 
 /// A diffuse floor of albedo ρ under a point light: every pixel that sees the floor has
 /// radiance ρ·I·cosθ/(π·d²), evaluated here in f64 from the analytic ray–plane hit.
@@ -346,7 +345,7 @@ fn rows_refuses_a_short_row_buffer() {
 }
 
 fn small(name: &str, w: u32, h: u32) -> (DesktopScene, PhotonSettings) {
-    let loaded = parse_scene(&read(name)).unwrap();
+    let loaded = parse_scene(&scene_text(name)).unwrap();
     let mut scene = loaded.scene;
     scene.set_camera(scene.camera().with_size(w, h).unwrap());
     let p = loaded.photons;
@@ -404,7 +403,7 @@ fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
 /// The Fig. 6 scene the device builds in code is the scene in `scenes/fig6.json`.
 #[test]
 fn the_device_scene_is_the_scene_file() {
-    let file = parse_scene(&read("fig6.json")).unwrap().scene;
+    let file = parse_scene(&scene_text("fig6.json")).unwrap().scene;
     let code: DesktopScene = caustic::demo::fig6(320, 240).unwrap();
     assert_eq!(file.objects(), code.objects());
     assert_eq!(file.lights(), code.lights());
@@ -429,7 +428,7 @@ fn example_scenes_parse() {
 
 /// Applies `edit` to the glass-sphere scene's JSON and returns the parse error.
 fn error_after(edit: impl FnOnce(&mut serde_json::Value)) -> caustic::desktop::SceneError {
-    let mut v: serde_json::Value = serde_json::from_str(&read("glass_sphere.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&scene_text("glass_sphere.json")).unwrap();
     edit(&mut v);
     parse_scene(&v.to_string()).expect_err("must be rejected")
 }
@@ -676,7 +675,7 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     let bad = dir.join("bad.json");
     std::fs::write(
         &bad,
-        read("glass_sphere.json").replace("\"radius\": 1.0", "\"radius\": 0"),
+        scene_text("glass_sphere.json").replace("\"radius\": 1.0", "\"radius\": 0"),
     )
     .unwrap();
     let exe = env!("CARGO_BIN_EXE_caustic");
@@ -736,7 +735,7 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     // The PFM holds exactly the image the library renders from the same file and flags
     // (seed 0, the file's gather): the program adds nothing and the PFM round trip
     // loses no bit.
-    let loaded = parse_scene(&read("glass_sphere.json")).unwrap();
+    let loaded = parse_scene(&scene_text("glass_sphere.json")).unwrap();
     let mut want_scene = loaded.scene;
     want_scene.set_camera(want_scene.camera().with_size(40, 30).unwrap());
     let p = loaded.photons;

@@ -5,7 +5,10 @@
 //! Case counts are moderate for CI. Longer runs:
 //! `PROPTEST_CASES=100000 cargo test --release --test stability` (every property), and
 //! `CAUSTIC_STRESS_SCENES=10000 cargo test --release --test stability random_scenes`
-//! (the random-scene count; default 300). See `docs/stability.md`.
+//! (the random-scene count; CI runs the default 300). Scenes built to be slow are in
+//! `tests/hostile.rs`. See `docs/stability.md`.
+
+mod support;
 
 use caustic::camera::Camera;
 use caustic::desktop::run::{render_rows, Progress};
@@ -16,9 +19,10 @@ use caustic::light::PointLight;
 use caustic::material::{interface, Classic, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
 use caustic::photon::{self, NoCaustics, Photon, PhotonSettings};
-use caustic::render::Renderer;
+use caustic::render::{Renderer, DEFAULT_RAY_BUDGET};
 use proptest::prelude::*;
 use serde_json::Value;
+use support::{scene_text, Rng};
 
 // ---------------------------------------------------------------------------------
 // Shapes: an independent f64 oracle for each.
@@ -491,10 +495,6 @@ fn translate(shape: &Shape, off: Vec3) -> Shape {
 // Whole renders: scale and translation invariance.
 // ---------------------------------------------------------------------------------
 
-fn scene_text(name: &str) -> String {
-    std::fs::read_to_string(format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
-}
-
 const SCENES: [&str; 4] = [
     "fig6.json",
     "glass_sphere.json",
@@ -646,49 +646,14 @@ fn translation_far_from_the_origin_is_measured() {
 // Random scenes.
 // ---------------------------------------------------------------------------------
 
-/// SplitMix64: a tiny deterministic generator for the scene fuzzer.
-struct Rng(u64);
-
-impl Rng {
-    fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f32 {
-        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.f()
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.u64() % n
-    }
-    fn chance(&mut self, p: f32) -> bool {
-        self.f() < p
-    }
-    fn v(&mut self, e: f32) -> Vec3 {
-        Vec3::new(self.range(-e, e), self.range(-e, e), self.range(-e, e))
-    }
-    fn rgb(&mut self, max: f32) -> Rgb {
-        Rgb::new(
-            self.range(0.0, max),
-            self.range(0.0, max),
-            self.range(0.0, max),
-        )
-    }
-    /// Mostly ordinary values, sometimes the edges of the allowed range.
-    fn ior(&mut self) -> f32 {
-        match self.below(8) {
-            0 => 1.0,
-            1 => [1e-3, 0.5, 100.0, 1e4][self.below(4) as usize],
-            _ => self.range(1.0, 2.5),
-        }
+/// Mostly ordinary values, sometimes the edges of the allowed range.
+fn ior(rng: &mut Rng) -> f32 {
+    match rng.below(8) {
+        0 => 1.0,
+        1 => [1e-3, 0.5, 100.0, 1e4][rng.below(4) as usize],
+        _ => rng.range(1.0, 2.5),
     }
 }
-
 fn random_material(rng: &mut Rng, s: f32) -> Material {
     match rng.below(5) {
         0 => Material::diffuse(rng.rgb(1.0)),
@@ -699,7 +664,7 @@ fn random_material(rng: &mut Rng, s: f32) -> Material {
             } else {
                 rng.rgb(3.0) * (1.0 / s)
             };
-            Material::dielectric(rng.ior(), absorption)
+            Material::dielectric(ior(rng), absorption)
         }
         _ => {
             let reflectivity = rng.f();
@@ -716,7 +681,7 @@ fn random_material(rng: &mut Rng, s: f32) -> Material {
                 },
                 reflectivity,
                 transparency,
-                rng.ior(),
+                ior(rng),
             ))
         }
     }
@@ -836,8 +801,21 @@ fn check_random_scene(seed: u64) -> Option<usize> {
         passes: 1 + (seed % 2) as u32,
         ..RenderOptions::default()
     };
-    let (image, _) =
+    let t = std::time::Instant::now();
+    let (image, stats) =
         render(&scene, &settings, &opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+    // The work is bounded by the ray budget per pixel and pass (deterministic), and —
+    // a safety net only — an 8×6 render takes well under 2 s even at opt-level 1.
+    let rays = stats.rays.eye + stats.rays.shadow;
+    assert!(
+        rays <= 48 * DEFAULT_RAY_BUDGET as u64 * opts.passes as u64,
+        "seed {seed}: {rays}"
+    );
+    assert!(
+        t.elapsed().as_secs_f64() < 2.0,
+        "seed {seed}: {:?}",
+        t.elapsed()
+    );
     for p in &image.pixels {
         assert!(
             p.is_finite() && p.min_channel() >= 0.0,
