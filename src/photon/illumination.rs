@@ -67,10 +67,10 @@ use core::f32::consts::PI;
 
 use heapless::Vec as FixedVec;
 
-use self::chart::{bounded_grids, distance, locate, pair, Grid, Located, Profile};
+use self::chart::{bounded_grids, pair, Grid, Profile};
 use super::{for_each_photon, CausticStore, ForwardStats, Photon, PhotonSettings};
 use crate::error::{positive, Error};
-use crate::geometry::Shape;
+use crate::geometry::{Shape, SurfacePoint};
 use crate::material::Classic;
 use crate::math::{max_abs, Rgb, UnitVec3, Vec3};
 use crate::scene::Scene;
@@ -613,17 +613,17 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// The mapped object (slot) nearest to `x` within tolerance, and where `x` lies on it.
     #[inline]
-    fn find(&self, x: Vec3, n: Option<UnitVec3>) -> Option<(usize, Located)> {
+    fn find(&self, x: Vec3, n: Option<UnitVec3>) -> Option<(usize, SurfacePoint)> {
         let tol = 1e-4 * max_abs(x).max(1.0);
         let mut best: Option<(usize, f32)> = None;
         for (k, m) in self.objects.iter().enumerate() {
-            let d = distance(&m.shape, x);
+            let d = m.shape.surface_distance(x);
             if d <= tol && best.is_none_or(|(_, bd)| d < bd) {
                 best = Some((k, d));
             }
         }
         let (k, _) = best?;
-        Some((k, locate(&self.objects[k].shape, x, n)))
+        Some((k, self.objects[k].shape.locate(x, n)))
     }
 
     /// Splats `power` (any unit) arriving at `x` along `dir` into the four texels
