@@ -282,7 +282,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             s.store_direct,
             &mut rng,
         )?;
-        Some(Photon::new(hit.pos, hit.dir, hit.power * (1.0 / self.unit)))
+        Some(Photon::new(hit.pos, hit.dir, hit.power * (1.0 / self.unit)).on_surface(hit.object))
     }
 }
 

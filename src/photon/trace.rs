@@ -12,6 +12,8 @@ pub(crate) struct Landing {
     pub pos: Vec3,
     pub dir: UnitVec3,
     pub power: Rgb,
+    /// Index of the scene object it landed on.
+    pub object: usize,
 }
 
 /// Follows one photon from the light.
@@ -44,6 +46,7 @@ pub(crate) fn trace<const O: usize, const L: usize>(
                 pos: hit.point,
                 dir: ray.dir,
                 power,
+                object: index,
             });
         }
         let dir = match material {
