@@ -17,6 +17,11 @@ use support::{fnv1a, Rng};
 /// Scenes through the program: the issue's bar.
 const SCENES: u64 = 150;
 
+/// The wall-clock safety net per scene: the issue's 10 s with an optimised program
+/// (`tools/hostile_scenes.sh`), three times that in the test profile (opt-level 1, debug
+/// assertions) on a shared machine. Measured: see the README's stability section.
+const GUARD_SECONDS: f64 = if cfg!(debug_assertions) { 30.0 } else { 10.0 };
+
 /// What one run of the program did.
 struct Run {
     seconds: f64,
@@ -87,7 +92,7 @@ fn check_work(seed: u64, scene: &serde_json::Value, stats: &serde_json::Value) {
 
 /// The issue's bar: 150 hostile scenes through the `caustic` program, each exits 0 with
 /// finite pixels or 2 with a message, none panics, each within its work bound, and —
-/// a safety net only, the bound above is the test — none over 10 s.
+/// a safety net only, the bound above is the test — none over 10 s (optimised).
 #[test]
 fn hostile_scenes_through_the_program() {
     let dir = std::env::temp_dir().join(format!("caustic-hostile-{}", std::process::id()));
@@ -100,7 +105,11 @@ fn hostile_scenes_through_the_program() {
         if run.seconds > slowest.0 {
             slowest = (run.seconds, seed);
         }
-        assert!(run.seconds < 10.0, "seed {seed}: {:.1} s", run.seconds);
+        assert!(
+            run.seconds < GUARD_SECONDS,
+            "seed {seed}: {:.1} s",
+            run.seconds
+        );
     }
     println!(
         "{SCENES} hostile scenes: {rendered} rendered, the others refused; slowest {:.2} s \

@@ -692,7 +692,16 @@ fn the_program_reports_bad_input_with_exit_status_2() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(dir).ok();
+}
 
+/// The program renders what the library renders: its PFM holds the library's bits, its
+/// `--stats` the sizes and counts, and `compare` measures a known difference.
+#[test]
+fn the_program_writes_the_library_image_and_compares_it() {
+    let dir = std::env::temp_dir().join(format!("caustic-cli-ok-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = env!("CARGO_BIN_EXE_caustic");
     let scene = format!("{}/scenes/glass_sphere.json", env!("CARGO_MANIFEST_DIR"));
     let (png, pfm) = (dir.join("g.png"), dir.join("g.pfm"));
     let out = std::process::Command::new(exe)

@@ -65,12 +65,115 @@ fn light(position: Value, rng: &mut Rng) -> Value {
     json!({"type": "point", "position": position, "intensity": rgb(rng, 80.0)})
 }
 
+/// The parts of a scene a kind builds on.
+struct Parts {
+    camera: Value,
+    objects: Vec<Value>,
+    lights: Vec<Value>,
+    store: Value,
+    /// `(k, max_radius)` of the gather.
+    gather: (u64, f32),
+}
+
+/// Kind 0: forking classic objects inside a reflective classic room.
+fn deep_classic_trees(rng: &mut Rng, p: &mut Parts) {
+    for _ in 0..4 + rng.below(10) {
+        p.objects.push(blob(rng, 1.0, "fork"));
+    }
+    p.objects.push(
+        json!({"type": "box", "center": [0, 0, 0], "size": [14, 14, 14],
+                          "material": "room"}),
+    );
+    p.lights.push(light(v3(rng, 3.0), rng));
+}
+
+/// Kind 1: 12–40 overlapping glass objects of two indices.
+fn overlapping_glass(rng: &mut Rng, p: &mut Parts) {
+    for i in 0..12 + rng.below(29) {
+        let m = if i % 2 == 0 { "glass" } else { "glass2" };
+        p.objects.push(blob(rng, 1.2, m));
+    }
+}
+
+/// Kind 2: the camera inside three nested glass spheres, among forking objects.
+fn camera_in_glass(rng: &mut Rng, p: &mut Parts) {
+    let at = v3(rng, 0.5);
+    p.camera["position"] = at.clone();
+    p.camera["look_at"] = v3(rng, 3.0);
+    for r in [0.8, 1.6, 3.0] {
+        p.objects
+            .push(json!({"type": "sphere", "center": at, "radius": r,
+                              "material": "glass"}));
+    }
+    for _ in 0..4 {
+        p.objects.push(blob(rng, 1.5, "fork"));
+    }
+}
+
+/// Kind 3: lights inside glass, a closed diffuse box, a mirror box, and on a sphere.
+fn lights_in_objects(rng: &mut Rng, p: &mut Parts) {
+    p.objects
+        .push(json!({"type": "sphere", "center": [0, 0, 0], "radius": 1.0,
+                          "material": "glass"}));
+    p.objects.push(
+        json!({"type": "box", "center": [2.5, 0, 0], "size": [1, 1, 1],
+                          "material": "floor"}),
+    );
+    p.objects.push(
+        json!({"type": "box", "center": [-2.5, 0, 0], "size": [1.2, 1.2, 1.2],
+                          "material": "mirror"}),
+    );
+    p.lights = vec![
+        light(json!([0.1, 0.2, 0.0]), rng),
+        light(json!([2.5, 0.1, 0.0]), rng),
+        light(json!([-2.5, 0.0, 0.1]), rng),
+        light(json!([0.0, 1.0, 0.0]), rng),
+    ];
+}
+
+/// Kind 4: planes through the camera and the light, a grazing glass plane twice, and
+/// two facing mirrors.
+fn grazing_planes(rng: &mut Rng, p: &mut Parts) {
+    p.objects
+        .push(json!({"type": "plane", "point": [0.0, 1.5, 6.0],
+                          "normal": [0.0, 1.0, 1e-4], "material": "floor"}));
+    p.objects
+        .push(json!({"type": "plane", "point": [2.0, 5.0, 3.0],
+                          "normal": v3(rng, 1.0), "material": "fork"}));
+    let grazing = json!({"type": "plane", "point": [0.0, 1.4999, 0.0],
+                         "normal": [0.0, 1.0, 1e-6], "material": "glass"});
+    p.objects.push(grazing.clone());
+    p.objects.push(grazing);
+    p.objects.push(
+        json!({"type": "plane", "point": [-4, 0, 0], "normal": [1, 0, 0],
+                          "material": "mirror"}),
+    );
+    p.objects.push(
+        json!({"type": "plane", "point": [4, 0, 0], "normal": [-1, 0, 0],
+                          "material": "mirror"}),
+    );
+    p.objects.push(blob(rng, 1.0, "glass"));
+}
+
+/// Kind 5: glass before a wall, illumination maps with a tiny texel, the largest gather.
+fn tiny_texels(rng: &mut Rng, p: &mut Parts) {
+    for _ in 0..3 + rng.below(6) {
+        p.objects.push(blob(rng, 1.0, "glass"));
+    }
+    p.objects.push(
+        json!({"type": "plane", "point": [0, 0, -3], "normal": [0, 0, 1],
+                          "material": "floor"}),
+    );
+    p.store = json!({"type": "illumination_map", "texel_size": rng.range(1e-4, 1e-2)});
+    p.gather = (1024, 10.0);
+}
+
 /// Hostile scene number `seed` as scene-file JSON (see the module documentation).
 pub fn hostile_scene(seed: u64) -> Value {
     let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x486f_7374);
     let kind = seed % 6;
-    let mut camera = json!({"position": [0.0, 1.5, 6.0], "look_at": [0.0, 0.3, 0.0],
-                            "fov_y_deg": rng.range(20.0, 120.0)});
+    let camera = json!({"position": [0.0, 1.5, 6.0], "look_at": [0.0, 0.3, 0.0],
+                        "fov_y_deg": rng.range(20.0, 120.0)});
     let mut materials = json!({
         "floor": {"type": "diffuse", "albedo": rgb(&mut rng, 1.0)},
         "mirror": {"type": "mirror", "reflectance": [1.0, 1.0, 1.0]},
@@ -79,110 +182,43 @@ pub fn hostile_scene(seed: u64) -> Value {
         "glass": glass(&mut rng),
         "glass2": glass(&mut rng),
     });
-    let mut objects = vec![
-        json!({"type": "plane", "point": [0, -1.5, 0], "normal": [0, 1, 0],
-                                  "material": "floor"}),
+    let mut p = Parts {
+        camera,
+        objects: vec![
+            json!({"type": "plane", "point": [0, -1.5, 0], "normal": [0, 1, 0],
+                             "material": "floor"}),
+        ],
+        lights: vec![light(json!([2.0, 5.0, 3.0]), &mut rng)],
+        store: json!({"type": "kd_tree"}),
+        gather: (1 + rng.below(128), rng.range(0.01, 0.5)),
+    };
+    let build = [
+        deep_classic_trees,
+        overlapping_glass,
+        camera_in_glass,
+        lights_in_objects,
+        grazing_planes,
+        tiny_texels,
     ];
-    let mut lights = vec![light(json!([2.0, 5.0, 3.0]), &mut rng)];
-    let mut store = json!({"type": "kd_tree"});
-    let (mut k, mut radius) = (1 + rng.below(128), rng.range(0.01, 0.5));
-    match kind {
-        0 => {
-            for _ in 0..4 + rng.below(10) {
-                objects.push(blob(&mut rng, 1.0, "fork"));
-            }
-            objects.push(
-                json!({"type": "box", "center": [0, 0, 0], "size": [14, 14, 14],
-                                "material": "room"}),
-            );
-            lights.push(light(v3(&mut rng, 3.0), &mut rng));
-        }
-        1 => {
-            for i in 0..12 + rng.below(29) {
-                let m = if i % 2 == 0 { "glass" } else { "glass2" };
-                objects.push(blob(&mut rng, 1.2, m));
-            }
-        }
-        2 => {
-            let at = v3(&mut rng, 0.5);
-            camera["position"] = at.clone();
-            camera["look_at"] = v3(&mut rng, 3.0);
-            for r in [0.8, 1.6, 3.0] {
-                objects.push(json!({"type": "sphere", "center": at, "radius": r,
-                                    "material": "glass"}));
-            }
-            for _ in 0..4 {
-                objects.push(blob(&mut rng, 1.5, "fork"));
-            }
-        }
-        3 => {
-            objects.push(json!({"type": "sphere", "center": [0, 0, 0], "radius": 1.0,
-                                "material": "glass"}));
-            objects.push(
-                json!({"type": "box", "center": [2.5, 0, 0], "size": [1, 1, 1],
-                                "material": "floor"}),
-            );
-            objects.push(
-                json!({"type": "box", "center": [-2.5, 0, 0], "size": [1.2, 1.2, 1.2],
-                                "material": "mirror"}),
-            );
-            lights = vec![
-                light(json!([0.1, 0.2, 0.0]), &mut rng),
-                light(json!([2.5, 0.1, 0.0]), &mut rng),
-                light(json!([-2.5, 0.0, 0.1]), &mut rng),
-                light(json!([0.0, 1.0, 0.0]), &mut rng), // on the sphere
-            ];
-        }
-        4 => {
-            // Through the camera, through the light, nearly along the view, twice.
-            objects.push(json!({"type": "plane", "point": [0.0, 1.5, 6.0],
-                                "normal": [0.0, 1.0, 1e-4], "material": "floor"}));
-            objects.push(json!({"type": "plane", "point": [2.0, 5.0, 3.0],
-                                "normal": v3(&mut rng, 1.0), "material": "fork"}));
-            let grazing = json!({"type": "plane", "point": [0.0, 1.4999, 0.0],
-                                 "normal": [0.0, 1.0, 1e-6], "material": "glass"});
-            objects.push(grazing.clone());
-            objects.push(grazing);
-            objects.push(
-                json!({"type": "plane", "point": [-4, 0, 0], "normal": [1, 0, 0],
-                                "material": "mirror"}),
-            );
-            objects.push(
-                json!({"type": "plane", "point": [4, 0, 0], "normal": [-1, 0, 0],
-                                "material": "mirror"}),
-            );
-            objects.push(blob(&mut rng, 1.0, "glass"));
-        }
-        _ => {
-            for _ in 0..3 + rng.below(6) {
-                objects.push(blob(&mut rng, 1.0, "glass"));
-            }
-            objects.push(
-                json!({"type": "plane", "point": [0, 0, -3], "normal": [0, 0, 1],
-                                "material": "floor"}),
-            );
-            store = json!({"type": "illumination_map", "texel_size": rng.range(1e-4, 1e-2)});
-            (k, radius) = (1024, 10.0);
-        }
-    }
+    build[kind as usize](&mut rng, &mut p);
     for _ in 0..rng.below(3) {
-        lights.push(light(v3(&mut rng, 4.0), &mut rng));
+        p.lights.push(light(v3(&mut rng, 4.0), &mut rng));
     }
     if rng.chance(0.3) {
         materials["glass"]["ior"] = json!(1.0);
     }
     json!({
-        "camera": camera,
+        "camera": p.camera,
         "image": {"width": 16, "height": 12},
         "background": rgb(&mut rng, 0.5),
         "ambient": rgb(&mut rng, 0.3),
-        "lights": lights,
+        "lights": p.lights,
         "materials": materials,
-        "objects": objects,
+        "objects": p.objects,
         "photons": {
-            "count": 1000 + rng.below(19_001), "k": k, "max_radius": radius,
+            "count": 1000 + rng.below(19_001), "k": p.gather.0, "max_radius": p.gather.1,
             "max_depth": 30, "passes": if kind == 5 { 1 } else { 1 + rng.below(3) },
-            "caustic_store": store
+            "caustic_store": p.store
         }
     })
 }
