@@ -153,7 +153,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// channel below `cutoff ∈ [0, 1]` is not traced. `0` traces every non-black branch.
     /// Default [`DEFAULT_CUTOFF`]; see the [module documentation](self).
     pub fn with_cutoff(mut self, cutoff: f32) -> Result<Self, Error> {
-        self.cutoff = crate::error::in_range(cutoff, 0.0, 1.0, "image.ray_cutoff")?;
+        self.cutoff = crate::error::in_range(cutoff, 0.0, 1.0, "ray cutoff")?;
         Ok(self)
     }
 
