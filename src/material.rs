@@ -5,7 +5,7 @@
 //! paper's `Classic` coefficient model is reproduced as the paper states it.
 
 use crate::error::{in_range, positive, Error};
-use crate::math::{Rgb, UnitVec3};
+use crate::math::{max_num, min_num, sqrt, Rgb, UnitVec3};
 
 /// The closed set of materials.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -118,6 +118,22 @@ impl Material {
             Material::Mirror(_) | Material::Dielectric(_) => false,
         }
     }
+
+    /// How a surface turns caustic light into radiance towards the eye: the radiance
+    /// leaving towards `to_eye` per unit of flux density (W/m²) arriving from
+    /// `to_light`. Diffuse: the BRDF `ρ/π`. Classic: `π·kernel` — the paper's eq. 8
+    /// divides `Σ kernel·Φ` by `r²`, that is `π·kernel` times the flux density
+    /// `Σ Φ/(πr²)`. Mirror and glass: none (light through them is traced on).
+    /// Both the gather (a density times this) and the light tracer (a photon's flux
+    /// times the camera's importance times this) ask it.
+    #[inline]
+    pub fn caustic_response(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
+        match self {
+            Material::Diffuse(m) => m.albedo * core::f32::consts::FRAC_1_PI,
+            Material::Classic(c) => c.kernel(n, to_light, to_eye) * core::f32::consts::PI,
+            Material::Mirror(_) | Material::Dielectric(_) => Rgb::ZERO,
+        }
+    }
 }
 
 impl Classic {
@@ -153,9 +169,11 @@ impl Classic {
     /// and the direction towards the eye.
     #[inline]
     pub fn kernel(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
-        let cos_l = n.dot(to_light.get()).max(0.0);
+        let cos_l = max_num(n.dot(to_light.get()), 0.0);
         let spec = match UnitVec3::new(to_light.get() + to_eye.get()) {
-            Some(h) if self.specular > 0.0 => powi_real(n.dot(h.get()).max(0.0), self.shininess),
+            Some(h) if self.specular > 0.0 => {
+                powi_real(max_num(n.dot(h.get()), 0.0), self.shininess)
+            }
             _ => 0.0,
         };
         self.color * (cos_l * self.diffuse + spec * self.specular)
@@ -215,7 +233,7 @@ pub fn interface(d: UnitVec3, n: UnitVec3, eta: f32) -> Interface {
             refracted: None,
         };
     }
-    let cos_t = libm::sqrtf(cos2_t.min(1.0));
+    let cos_t = sqrt(min_num(cos2_t, 1.0));
     // In units of eta_t: eta_i = eta, eta_t = 1.
     let rs = (eta_cos_i - cos_t) / (eta_cos_i + cos_t);
     let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);

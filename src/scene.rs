@@ -123,14 +123,13 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
         best
     }
 
-    /// `true` when anything lies along `ray` before `t_max`: the shadow-ray query.
-    /// Every object blocks, glass and mirrors included (light through them arrives
-    /// only as caustics).
+    /// `true` when anything lies along `ray` before `t_max`: the shadow-ray query, an
+    /// any-hit test that stops at the first blocker and asks each shape only whether
+    /// it blocks ([`Shape::blocks`], no hit point or normal). Every object blocks, glass
+    /// and mirrors included (light through them arrives only as caustics).
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.objects
-            .iter()
-            .any(|o| o.shape.intersect(ray, t_max).is_some())
+        self.objects.iter().any(|o| o.shape.blocks(ray, t_max))
     }
 }
 

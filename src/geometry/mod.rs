@@ -153,6 +153,19 @@ impl Shape {
         }
     }
 
+    /// `true` when the ray meets the shape at some `0 < t < t_max`: the answer of
+    /// `intersect(ray, t_max).is_some()` without building the hit's point and normal
+    /// (the shadow-ray query; boxes first try their bounding sphere).
+    #[inline]
+    pub fn blocks(&self, ray: &Ray, t_max: f32) -> bool {
+        match self {
+            Shape::Sphere(s) => s.blocks(ray, t_max),
+            Shape::Box(b) => b.blocks(ray, t_max),
+            Shape::Cylinder(c) => c.intersect(ray, t_max).is_some(),
+            Shape::Plane(p) => p.blocks(ray, t_max),
+        }
+    }
+
     /// A sphere containing the shape; `None` for the unbounded plane.
     pub fn bounding_sphere(&self) -> Option<BoundingSphere> {
         match self {
@@ -175,7 +188,7 @@ pub(crate) fn stable_roots(a: f32, b: f32, c: f32, disc: f32) -> Option<(f32, f3
     if !(disc >= 0.0) || a == 0.0 {
         return None;
     }
-    let q = -(b + libm::copysignf(libm::sqrtf(disc), b));
+    let q = -(b + libm::copysignf(crate::math::sqrt(disc), b));
     if q == 0.0 {
         // b = 0 and disc = 0: a double root at t = 0 (a tangent ray from the surface).
         return Some((0.0, 0.0));
@@ -209,6 +222,45 @@ pub(crate) mod tests {
         assert!((t1 - 1e4).abs() / 1e4 < 1e-6);
         assert!(stable_roots(1.0, 0.0, 1.0, -1.0).is_none());
         assert!(stable_roots(1.0, 0.0, 0.0, f32::NAN).is_none());
+    }
+
+    #[test]
+    fn blocks_is_intersect_is_some() {
+        // The shadow query must agree with the full one on every ray, including rays
+        // the box's bounding-sphere test rejects and rays that end just short of a hit.
+        let shapes = [
+            Shape::cuboid(
+                Vec3::new(2.0, 1.0, -1.0),
+                Vec3::splat(4.0),
+                Vec3::new(0.0, 30.0, 0.0),
+            )
+            .unwrap(),
+            Shape::cuboid(
+                Vec3::ZERO,
+                Vec3::new(0.5, 3.0, 1.0),
+                Vec3::new(10.0, 20.0, 30.0),
+            )
+            .unwrap(),
+            Shape::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0).unwrap(),
+            Shape::plane(Vec3::new(0.0, -5.0, 0.0), Vec3::Y).unwrap(),
+        ];
+        let mut g = crate::sampling::Pcg32::new(11);
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let o = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 16.0 - Vec3::splat(8.0);
+            let aim = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 6.0 - Vec3::splat(3.0);
+            let Some(dir) = UnitVec3::new(aim - o) else {
+                continue;
+            };
+            let r = Ray::new(o, dir);
+            let t_max = [f32::INFINITY, 1.0, 8.0, 12.0][(g.next_u32() % 4) as usize];
+            for s in &shapes {
+                let full = s.intersect(&r, t_max).is_some();
+                hits += full as u32;
+                assert_eq!(s.blocks(&r, t_max), full, "{s:?} {r:?} {t_max}");
+            }
+        }
+        assert!(hits > 5_000, "the rays must exercise hits too: {hits}");
     }
 
     #[test]

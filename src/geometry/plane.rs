@@ -55,6 +55,21 @@ impl Plane {
     }
 }
 
+impl Plane {
+    /// `true` when the ray meets the plane at some `0 < t < t_max` (the shadow-ray
+    /// query: [`intersect`](Self::intersect)'s distance only).
+    #[inline]
+    pub fn blocks(&self, ray: &Ray, t_max: f32) -> bool {
+        let n = self.normal.get();
+        let denom = n.dot(ray.dir.get());
+        if denom == 0.0 {
+            return false;
+        }
+        let t = n.dot(self.point - ray.origin) / denom;
+        t > 0.0 && t < t_max
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

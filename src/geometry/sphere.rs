@@ -44,18 +44,7 @@ impl Sphere {
     /// Gems ch. 7). The point is re-projected onto the sphere.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let d = ray.dir.get();
-        let f = ray.origin - self.center;
-        let b = f.dot(d);
-        let chord = f - d * b;
-        let r2 = self.radius * self.radius;
-        let disc = r2 - chord.length_squared();
-        let c = f.length_squared() - r2;
-        let (t0, t1) = stable_roots(1.0, b, c, disc)?;
-        let t = if t0 > 0.0 { t0 } else { t1 };
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
+        let t = self.distance(ray, t_max)?;
         let local = ray.at(t) - self.center;
         let normal = UnitVec3::new(local)?;
         let point = self.center + normal.get() * self.radius;
@@ -65,6 +54,28 @@ impl Sphere {
             normal,
             error: self.error,
         })
+    }
+
+    /// The distance of [`intersect`](Self::intersect)'s hit, without the point.
+    #[inline]
+    fn distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let d = ray.dir.get();
+        let f = ray.origin - self.center;
+        let b = f.dot(d);
+        let chord = f - d * b;
+        let r2 = self.radius * self.radius;
+        let disc = r2 - chord.length_squared();
+        let c = f.length_squared() - r2;
+        let (t0, t1) = stable_roots(1.0, b, c, disc)?;
+        let t = if t0 > 0.0 { t0 } else { t1 };
+        (t > 0.0 && t < t_max).then_some(t)
+    }
+
+    /// `true` when the ray meets the sphere at some `0 < t < t_max` (the shadow-ray
+    /// query: the roots only, no point or normal).
+    #[inline]
+    pub fn blocks(&self, ray: &Ray, t_max: f32) -> bool {
+        self.distance(ray, t_max).is_some()
     }
 }
 

@@ -89,7 +89,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 return sphere; // the light is inside the bound
             }
             let sin2 = r2 / d2;
-            let cos_max = libm::sqrtf(1.0 - sin2);
+            let cos_max = crate::math::sqrt(1.0 - sin2);
             let one_minus_cos = sin2 / (1.0 + cos_max);
             let solid_angle = 2.0 * PI * one_minus_cos;
             let (e1, e2) = axis.basis();
@@ -165,9 +165,9 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         match self {
             Emission::Sphere { count } => {
                 let (s, t) = hammersley(index, *count, shift);
-                let (sin_u, cos_u) = libm::sincosf(2.0 * PI * s);
+                let (sin_u, cos_u) = crate::math::sin_cos_turns(s);
                 let sin_v = 2.0 * t - 1.0;
-                let cos_v = libm::sqrtf((1.0 - sin_v * sin_v).max(0.0));
+                let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
                 let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
                 let power = light.intensity() * (4.0 * PI / *count as f32);
                 (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power)
@@ -187,8 +187,8 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 let (s, t) = hammersley(local, c.count, shift);
                 let om = s * c.one_minus_cos; // 1 − cos θ
                 let cos_t = 1.0 - om;
-                let sin_t = libm::sqrtf((om * (2.0 - om)).max(0.0));
-                let (sin_p, cos_p) = libm::sincosf(2.0 * PI * t);
+                let sin_t = crate::math::sqrt(crate::math::max_num(om * (2.0 - om), 0.0));
+                let (sin_p, cos_p) = crate::math::sin_cos_turns(t);
                 let d = c.axis.get() * cos_t + (c.e1.get() * cos_p + c.e2.get() * sin_p) * sin_t;
                 let dir = UnitVec3::new(d).unwrap_or(c.axis);
                 let density: f32 = cones

@@ -3,6 +3,7 @@
 use core::f32::consts::PI;
 
 use super::kdtree::{KdTree, Neighbor};
+use super::packed::Photon;
 use super::CausticStore;
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
@@ -38,6 +39,8 @@ pub struct KdStore<'a, const K: usize> {
     k: Option<usize>,
     max_radius2: f32,
     cone: Option<ConeFilter>,
+    /// The photons' bounding box (`lo`, `hi`); empty (`lo > hi`) without photons.
+    bounds: (Vec3, Vec3),
 }
 
 impl<'a, const K: usize> KdStore<'a, K> {
@@ -58,7 +61,30 @@ impl<'a, const K: usize> KdStore<'a, K> {
             k: k.map(|k| k.clamp(1, K.max(1))),
             max_radius2: max_radius * max_radius,
             cone,
+            bounds: bounds(tree.photons()),
         }
+    }
+
+    /// `true` when no photon can lie within the gather radius of `x`: `x` is farther
+    /// than the maximum radius from the photons' bounding box (or there are none). The
+    /// squared distance to the box is a lower bound of every photon's; it is compared
+    /// with the radius² widened by 10⁻⁴ (relative) so that rounding never skips a
+    /// gather that would have found a photon. A skipped gather returns exactly what the
+    /// full one would (a zero sum), in about 20 instructions instead of a tree walk.
+    #[inline]
+    fn out_of_reach(&self, x: Vec3) -> bool {
+        let (lo, hi) = self.bounds;
+        let below = lo - x;
+        let above = x - hi;
+        let gap = |a: f32, b: f32| crate::math::max(crate::math::max(a, b), 0.0);
+        let (gx, gy, gz) = (
+            gap(below.x, above.x),
+            gap(below.y, above.y),
+            gap(below.z, above.z),
+        );
+        let d2 = gx * gx + gy * gy + gz * gz;
+        // An empty tree has lo = +inf > hi = −inf: every gap is +inf.
+        !(d2 <= self.max_radius2 * (1.0 + 1e-4))
     }
 
     /// The tree.
@@ -75,12 +101,13 @@ impl<'a, const K: usize> KdStore<'a, K> {
         &self,
         x: Vec3,
         n: UnitVec3,
+        max_radius2: f32,
         mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
         let photons = self.tree.photons();
         let filter = |r2: f32| match self.cone {
             Some(c) => (
-                1.0 / (c.k * libm::sqrtf(r2)),
+                1.0 / (c.k * crate::math::sqrt(r2)),
                 1.0 / (1.0 - 2.0 / (3.0 * c.k)),
             ),
             None => (0.0, 1.0),
@@ -93,7 +120,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 return; // arrived from behind the surface
             }
             let w = if self.cone.is_some() {
-                1.0 - libm::sqrtf(dist2) * inv_kr
+                1.0 - crate::math::sqrt(dist2) * inv_kr
             } else {
                 1.0
             };
@@ -102,13 +129,13 @@ impl<'a, const K: usize> KdStore<'a, K> {
         let (r2, norm) = match self.k {
             Some(k) => {
                 let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
-                let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
+                let found = self.tree.k_nearest(x, max_radius2, k, &mut buf);
                 // Photon positions are known to about ε·|x|, and no estimate resolves
                 // detail below 10⁻⁴ of the gather radius: k photons all at the query
                 // point would otherwise divide by r² = 0. Floor r² there.
                 let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
                 let floor = crate::math::max(
-                    crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
+                    crate::math::max(ulp * ulp, 1e-8 * max_radius2),
                     f32::MIN_POSITIVE,
                 );
                 let r2 = crate::math::max(found.radius2, floor);
@@ -119,7 +146,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 (r2, norm)
             }
             None => {
-                let r2 = self.max_radius2;
+                let r2 = max_radius2;
                 let (inv_kr, norm) = filter(r2);
                 self.tree.search(x, r2, |index, dist2| {
                     add(index, dist2, inv_kr);
@@ -132,26 +159,83 @@ impl<'a, const K: usize> KdStore<'a, K> {
     }
 }
 
+impl<const K: usize> KdStore<'_, K> {
+    /// The gather radius² bound: the store's maximum radius, or `radius` if smaller
+    /// (but never a radius whose square is not a normal float).
+    #[inline]
+    fn bound2(&self, radius: f32) -> f32 {
+        let r2 = radius * radius;
+        if r2 >= f32::MIN_POSITIVE && r2 < self.max_radius2 {
+            r2
+        } else {
+            self.max_radius2
+        }
+    }
+
+    /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons within `√r2_max`.
+    #[inline]
+    fn irradiance2(&self, x: Vec3, n: UnitVec3, r2_max: f32) -> Rgb {
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, r2_max, |_, power| power);
+        sum * (1.0 / (PI * r2))
+    }
+
+    /// Paper eq. 8 over the photons within `√r2_max`.
+    #[inline]
+    fn classic2(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic, r2_max: f32) -> Rgb {
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, r2_max, |dir, power| m.kernel(n, -dir, to_eye) * power);
+        sum * (1.0 / r2)
+    }
+}
+
+/// The bounding box of the photons' positions, `(lo, hi)`; `lo = +∞`, `hi = −∞`
+/// without photons.
+fn bounds(photons: &[Photon]) -> (Vec3, Vec3) {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in photons {
+        let q = p.position();
+        for i in 0..3 {
+            lo[i] = crate::math::min_num(lo[i], q[i]);
+            hi[i] = crate::math::max_num(hi[i], q[i]);
+        }
+    }
+    (lo, hi)
+}
+
 impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons, `r` the distance to
     /// the k-th (or the maximum radius when fewer are found): Jensen 2001, eq. 7.6,
     /// divided by the diffuse BRDF.
     #[inline]
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        if self.tree.is_empty() {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |_, power| power);
-        sum * (1.0 / (PI * r2))
+        self.irradiance2(x, n, self.max_radius2)
     }
 
     /// Paper eq. 8: `c = (1/r²) Σ (max(n·l,0)·k_d·color + max(n·h,0)^a·k_s·color)·energy`.
     #[inline]
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        if self.tree.is_empty() {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
-        sum * (1.0 / r2)
+        self.classic2(x, n, to_eye, m, self.max_radius2)
+    }
+
+    #[inline]
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
+        self.irradiance2(x, n, self.bound2(radius))
+    }
+
+    #[inline]
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        to_eye: UnitVec3,
+        m: &Classic,
+        radius: f32,
+    ) -> Rgb {
+        self.classic2(x, n, to_eye, m, self.bound2(radius))
     }
 }

@@ -15,9 +15,9 @@
 //!    cycles of `h ↦ inorder_index(h)`, marking visited photons with a scratch bit.
 //!    Cost `O(N)`.
 //!
-//! Queries walk the tree with an explicit stack of at most 32 entries (a `u32` index
-//! bounds the height), nearer child first, and visit the far child only when the
-//! splitting plane is closer than the current search radius.
+//! Queries walk the tree without a stack (a node's parent is `(i − 1)/2`), nearer
+//! child first, and visit the far child only when the splitting plane is closer than
+//! the current search radius.
 
 use super::packed::{Photon, AXIS_MASK, SCRATCH};
 use crate::math::Vec3;
@@ -256,41 +256,56 @@ impl<'a> KdTree<'a> {
 
     /// Calls `visit(index, dist2)` for each photon with squared distance `< radius2`
     /// from `x`; `visit` returns the (possibly smaller) radius² to search on with.
+    ///
+    /// Depth first, nearer child first, without a stack: in heap order a node's parent
+    /// is `(i − 1)/2`, so the walk climbs back from a finished subtree and recomputes
+    /// the parent's plane distance to learn whether it came from the near side (then
+    /// the parent is visited and its far side searched if the plane is within reach)
+    /// or from the far side (then that subtree is finished too). The order of visits,
+    /// and so every result, is that of the recursive search; the stack it saves was
+    /// 256 bytes to clear per query, 2.4 % of the device render.
     #[inline]
     pub fn search(&self, x: Vec3, mut radius2: f32, mut visit: impl FnMut(usize, f32) -> f32) {
-        let n = self.photons.len();
-        let mut stack = [(0u32, 0.0f32); MAX_HEIGHT];
-        let mut sp = 0usize;
+        let photons = self.photons;
+        let n = photons.len();
+        // An array, not `Vec3`: glam indexes a `Vec3` by a `match`, an array by address.
+        let xa = x.to_array();
+        let plane = |i: usize| {
+            let p = &photons[i];
+            let axis = p.axis();
+            xa[axis] - p.coord(axis)
+        };
         let mut i = 0usize;
         loop {
-            // Descend towards x, remembering each node and its signed plane distance.
+            // Descend towards x.
             while i < n {
-                let p = &self.photons[i];
-                let delta = x[p.axis()] - p.coord(p.axis());
-                stack[sp] = (i as u32, delta);
-                sp += 1;
-                i = if delta < 0.0 { 2 * i + 1 } else { 2 * i + 2 };
+                i = if plane(i) < 0.0 { 2 * i + 1 } else { 2 * i + 2 };
             }
-            if sp == 0 {
-                return;
-            }
-            sp -= 1;
-            let (node, delta) = stack[sp];
-            let node = node as usize;
-            let d2 = (self.photons[node].position() - x).length_squared();
-            if d2 < radius2 {
-                radius2 = visit(node, d2);
-            }
-            // The far side can hold closer photons only if the plane is within reach.
-            i = if delta * delta < radius2 {
-                if delta < 0.0 {
-                    2 * node + 2
-                } else {
-                    2 * node + 1
+            // Climb from the finished subtree at `i` until a far side is to be searched.
+            loop {
+                if i == 0 {
+                    return;
                 }
-            } else {
-                n
-            };
+                let node = (i - 1) / 2;
+                let delta = plane(node);
+                let (near, far) = if delta < 0.0 {
+                    (2 * node + 1, 2 * node + 2)
+                } else {
+                    (2 * node + 2, 2 * node + 1)
+                };
+                if i == near {
+                    let d2 = (photons[node].position() - x).length_squared();
+                    if d2 < radius2 {
+                        radius2 = visit(node, d2);
+                    }
+                    // The far side can hold closer photons only if the plane is within reach.
+                    if delta * delta < radius2 {
+                        i = far;
+                        break;
+                    }
+                }
+                i = node;
+            }
         }
     }
 

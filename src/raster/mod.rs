@@ -14,11 +14,54 @@ use crate::math::Rgb;
 use srgb_table::SRGB8_THRESHOLDS;
 
 /// Encodes a linear value in `[0, 1]` (clamped; NaN gives 0) to the nearest 8-bit sRGB
-/// code, by binary search in the threshold table.
+/// code: the number of thresholds at or below `x`.
+///
+/// Counted from a start found by the value's bits: for positive floats the bit
+/// patterns are ordered like the values, so the exponent and the top four mantissa bits
+/// name one of [`BUCKETS`] sixteenths of an octave in `[2⁻¹³, 1)`, and `BUCKET_START`
+/// holds the count at the bucket's lower end. At most a few thresholds lie in a bucket,
+/// so a short forward scan ends the count — about 25 instructions a channel instead
+/// of a binary search's 85 (2.5 % of the device render), with the same result.
 #[inline]
 pub fn linear_to_srgb8(x: f32) -> u8 {
-    SRGB8_THRESHOLDS.partition_point(|&t| t <= x) as u8
+    if !(x >= BUCKET_FLOOR) {
+        return 0; // below every threshold, negative, or NaN
+    }
+    if x >= 1.0 {
+        return 255; // above every threshold
+    }
+    let bucket = ((x.to_bits() >> BUCKET_SHIFT) - (FIRST_EXPONENT << 4)) as usize;
+    let mut k = BUCKET_START[bucket] as usize;
+    while k < SRGB8_THRESHOLDS.len() && SRGB8_THRESHOLDS[k] <= x {
+        k += 1;
+    }
+    k as u8
 }
+
+/// The biased exponent of [`BUCKET_FLOOR`] = 2⁻¹³, below the first threshold (1.5·10⁻⁴).
+const FIRST_EXPONENT: u32 = 127 - 13;
+/// The smallest value with a bucket.
+const BUCKET_FLOOR: f32 = 1.0 / 8192.0;
+const _: () = assert!(BUCKET_FLOOR < SRGB8_THRESHOLDS[0] && SRGB8_THRESHOLDS[254] < 1.0);
+/// Shift that keeps the exponent and four mantissa bits of an `f32`.
+const BUCKET_SHIFT: u32 = 19;
+/// Sixteen buckets per octave from 2⁻¹³ up to 1.
+const BUCKETS: usize = 13 * 16;
+/// `BUCKET_START[b]`: thresholds at or below the lower end of bucket `b` (compared by
+/// their bits, which order positive floats as their values).
+const BUCKET_START: [u8; BUCKETS] = {
+    let mut out = [0u8; BUCKETS];
+    let (mut b, mut k) = (0, 0);
+    while b < BUCKETS {
+        let lower = ((FIRST_EXPONENT << 4) + b as u32) << BUCKET_SHIFT;
+        while k < SRGB8_THRESHOLDS.len() && SRGB8_THRESHOLDS[k].to_bits() <= lower {
+            k += 1;
+        }
+        out[b] = k as u8;
+        b += 1;
+    }
+    out
+};
 
 /// Decodes an 8-bit sRGB code to linear (the inverse transfer function, for tests and
 /// tools; uses `powf`).
@@ -84,6 +127,32 @@ mod tests {
             };
             assert_eq!(t, x as f32, "threshold {k}");
         }
+    }
+
+    #[test]
+    fn bucketed_count_is_the_binary_search() {
+        let search = |x: f32| SRGB8_THRESHOLDS.partition_point(|&t| t <= x) as u8;
+        let mut x = 1e-5f32;
+        while x < 1.5 {
+            for v in [
+                x,
+                f32::from_bits(x.to_bits() + 1),
+                f32::from_bits(x.to_bits() - 1),
+            ] {
+                assert_eq!(linear_to_srgb8(v), search(v), "{v}");
+            }
+            x *= 1.0007;
+        }
+        for &t in &SRGB8_THRESHOLDS {
+            for v in [
+                t,
+                f32::from_bits(t.to_bits() - 1),
+                f32::from_bits(t.to_bits() + 1),
+            ] {
+                assert_eq!(linear_to_srgb8(v), search(v), "{v}");
+            }
+        }
+        assert_eq!(BUCKET_FLOOR.to_bits() >> BUCKET_SHIFT, FIRST_EXPONENT << 4);
     }
 
     #[test]

@@ -63,7 +63,7 @@ fi
 
 # --- 2. firmware and plugin ------------------------------------------------------------
 step "building the firmware (release)"
-(cd "$fw" && cargo build --release)
+(cd "$fw" && CARGO_TARGET_DIR="$fw/target" cargo build --release)
 elf="$fw/target/thumbv7em-none-eabihf/release/caustic-cortex-m4"
 "$cc" -O2 -shared -fPIC -fvisibility=hidden -Wall -Wextra -Werror \
     -o "$out/insn_plugin.so" "$root/tools/device/insn_plugin.c"

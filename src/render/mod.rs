@@ -12,6 +12,22 @@
 //!   reflectivity·L_reflected + transparency·L_refracted`, where `kernel` is eq. 8's
 //!   summand with the light as its single photon.
 //!
+//! Caustic light at a diffuse hit comes from one of two estimators. Where the eye sees
+//! the surface directly, the forward pass has already added it to the pixel by light
+//! tracing ([`photon::Splat`](crate::photon::Splat), given to
+//! [`Renderer::with_splats`]): unbiased and exactly a pixel-area average. Where the eye
+//! sees it through glass or in a mirror, the caustic store gathers, within the
+//! footprint of the pixel's ray cone (`½·pixel angle·path length`, bounded by the
+//! store's own radius). Without splats the store gathers at every diffuse hit, as in
+//! the paper.
+//!
+//! A pixel's value is the average radiance over its area (box filter). The default
+//! [`Sampling::Adaptive`] traces the pixel's four corners (Whitted 1980's adaptive
+//! supersampling) and averages them where they agree — the same objects along the
+//! path, the same lights visible, luminance within a small contrast — and otherwise
+//! averages an `n × n` grid of sub-pixel rays: shadow edges, silhouettes and what is
+//! seen through glass get many rays, smooth regions one per pixel.
+//!
 //! A path takes at most `max_depth` specular interactions; one that meets a further
 //! specular surface contributes nothing. The tree of reflected and refracted branches
 //! is walked depth-first with an explicit stack of `DEPTH` entries: each pending entry
@@ -45,8 +61,14 @@ use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
-use crate::photon::CausticStore;
+use crate::photon::{CausticStore, Splat};
+
+mod estimate;
+mod pixels;
+
 use crate::scene::Scene;
+pub use estimate::{ErrorTally, PixelEstimate};
+pub use pixels::{Sampling, CONTRAST, REFINE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -91,12 +113,15 @@ pub struct RayCount {
     pub eye: u64,
     /// Shadow rays towards lights.
     pub shadow: u64,
+    /// Pixels whose corners disagreed and were supersampled.
+    pub refined: u64,
 }
 
 impl core::ops::AddAssign for RayCount {
     fn add_assign(&mut self, o: Self) {
         self.eye += o.eye;
         self.shadow += o.shadow;
+        self.refined += o.refined;
     }
 }
 
@@ -106,6 +131,34 @@ struct Branch {
     ray: Ray,
     weight: Rgb,
     depth: u32,
+    /// Distance travelled from the eye to the ray's origin.
+    travelled: f32,
+}
+
+/// Radiance along one eye ray, its caustic part, and a signature of what the path met:
+/// which objects, in which order, and which lights were visible at each shaded point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Radiance.
+    pub radiance: Rgb,
+    /// The part of `radiance` the caustic store gathered.
+    pub caustic: Rgb,
+    /// FNV-1a hash of the path's events.
+    pub signature: u32,
+}
+
+impl Sample {
+    const START: Sample = Sample {
+        radiance: Rgb::ZERO,
+        caustic: Rgb::ZERO,
+        signature: 0x811c_9dc5,
+    };
+
+    /// Folds one event into the signature (FNV-1a).
+    #[inline]
+    fn mix(&mut self, v: u32) {
+        self.signature = (self.signature ^ v).wrapping_mul(0x0100_0193);
+    }
 }
 
 /// Renders a scene against a caustic store, with a path stack of `DEPTH` entries.
@@ -114,8 +167,12 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     scene: &'a Scene<OBJECTS, LIGHTS>,
     store: &'a S,
     max_depth: u32,
-    /// Eye rays per pixel side: `n × n` per pixel.
-    samples: u32,
+    sampling: Sampling,
+    /// The camera's splats, when the forward pass made them: then the store gathers
+    /// only at diffuse points seen through glass or mirrors.
+    splats: Option<&'a [Splat]>,
+    /// Gather radius per unit of path length (`½·pixel angle·shrink`).
+    footprint: f32,
     /// Branches whose weight's largest channel is below this are not traced.
     cutoff: f32,
     /// Most rays (eye and shadow) per pixel.
@@ -127,7 +184,9 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
 impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     Renderer<'a, S, O, L, DEPTH>
 {
-    /// A renderer; an error when `max_depth` exceeds the compiled stack `DEPTH`.
+    /// A renderer with one ray per pixel centre and the store gathering at every
+    /// diffuse hit (the paper's method); an error when `max_depth` exceeds the compiled
+    /// stack `DEPTH`.
     pub fn new(scene: &'a Scene<O, L>, store: &'a S, max_depth: u32) -> Result<Self, Error> {
         if max_depth as usize > DEPTH {
             return Err(Error::Capacity {
@@ -141,7 +200,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             scene,
             store,
             max_depth,
-            samples: 1,
+            sampling: Sampling::Centre,
+            splats: None,
+            footprint: 0.5 * scene.camera().pixel_angle(),
             cutoff: DEFAULT_CUTOFF,
             ray_budget: DEFAULT_RAY_BUDGET,
             rays_per_hit: 1 + lit.count() as u32,
@@ -159,7 +220,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// At most `max_rays` rays (eye and shadow) per pixel; default
     /// [`DEFAULT_RAY_BUDGET`]. With `n × n` supersampling each sample gets
-    /// `⌊max_rays / n²⌋`, but never less than one eye ray and its shadow rays
+    /// `⌊max_rays / n²⌋` (`⌊max_rays / (n² + 4)⌋` adaptive, which may also trace the
+    /// pixel's four corners), but never less than one eye ray and its shadow rays
     /// (`1 + lit lights`). An error when `max_rays` is below `1 + lit lights`: the
     /// camera ray of a pixel could not be shaded.
     pub fn with_ray_budget(mut self, max_rays: u32) -> Result<Self, Error> {
@@ -177,24 +239,51 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// The rays one eye sample may spend.
     fn sample_budget(&self) -> u64 {
-        let n2 = self.samples as u64 * self.samples as u64;
+        // Samples a pixel may trace: its grid, and for the adaptive scheme its corners.
+        let n2 = match self.sampling {
+            Sampling::Centre => 1,
+            Sampling::Grid(n) => n as u64 * n as u64,
+            Sampling::Adaptive(n) => n as u64 * n as u64 + 4,
+        };
         (self.ray_budget as u64 / n2).max(self.rays_per_hit as u64)
     }
 
-    /// Supersampling: `n × n` eye rays per pixel on a regular grid of sub-pixel centres,
-    /// averaged (a box filter: the pixel-area average a sensor records). `n = 1`, the
-    /// default, is the one ray through the pixel centre of the scene format.
-    pub fn with_supersample(mut self, n: u32) -> Result<Self, Error> {
-        if !(1..=64).contains(&n) {
-            return Err(Error::OutOfRange {
-                what: "supersample",
-                value: n as f32,
-                min: 1.0,
-                max: 64.0,
-            });
+    /// The caustics seen directly come from these splats of the forward pass (in
+    /// emission order): [`rows`](Self::rows) adds them to their pixels, and the store
+    /// gathers only where a diffuse point is seen through glass or in a mirror, within
+    /// the pixel's footprint. [`row`](Self::row) does not add them (the desktop adds
+    /// all at once with [`add_to_frame`](crate::photon::add_to_frame)).
+    pub fn with_splats(mut self, splats: &'a [Splat]) -> Self {
+        self.splats = Some(splats);
+        self
+    }
+
+    /// Scales the gather footprint (progressive passes shrink it with the radius).
+    pub fn with_footprint_scale(mut self, scale: f32) -> Self {
+        self.footprint = 0.5 * self.scene.camera().pixel_angle() * scale;
+        self
+    }
+
+    /// How pixels are sampled; an error for a grid side outside `1..=64`.
+    pub fn with_sampling(mut self, sampling: Sampling) -> Result<Self, Error> {
+        if let Sampling::Grid(n) | Sampling::Adaptive(n) = sampling {
+            if !(1..=64).contains(&n) {
+                return Err(Error::OutOfRange {
+                    what: "supersample",
+                    value: n as f32,
+                    min: 1.0,
+                    max: 64.0,
+                });
+            }
         }
-        self.samples = n;
+        self.sampling = sampling;
         Ok(self)
+    }
+
+    /// Supersampling: `n × n` eye rays per pixel on a regular grid of sub-pixel centres,
+    /// averaged: [`Sampling::Grid`].
+    pub fn with_supersample(self, n: u32) -> Result<Self, Error> {
+        self.with_sampling(Sampling::Grid(n))
     }
 
     /// The scene.
@@ -205,12 +294,18 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Radiance arriving at the origin of `ray` along it, spending at most one sample's
     /// share of the ray budget (see the [module documentation](self)).
     pub fn radiance(&self, ray: Ray, count: &mut RayCount) -> Rgb {
+        self.sample(ray, count).radiance
+    }
+
+    /// Radiance arriving at the origin of `ray` along it, with the path's signature.
+    pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
-        let mut total = Rgb::ZERO;
+        let mut out = Sample::START;
         let mut next = Some(Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
+            travelled: 0.0,
         });
         let limit = count.eye + count.shadow + self.sample_budget();
         while let Some(b) = next.take().or_else(|| stack.pop()) {
@@ -219,12 +314,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             count.eye += 1;
             let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
-                total += b.weight * self.scene.background();
+                out.mix(u32::MAX);
+                out.radiance += b.weight * self.scene.background();
                 continue;
             };
+            out.mix(index as u32 | b.depth << 16);
             let material = &self.scene.objects()[index].material;
-            let (local, mut first, mut second) = self.scatter(&b, &hit, material, count);
-            total += local;
+            let (local, mut first, mut second) = self.scatter(&b, &hit, material, count, &mut out);
+            out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
             let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
@@ -238,10 +335,23 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
             }
         }
-        total
+        out
     }
 
-    /// Light leaving `hit` towards the eye directly, and up to two specular branches.
+    /// The caustic store's part at a diffuse point reached by branch `b`: none where
+    /// the splats already hold it (seen directly), else the gather, bounded by the
+    /// footprint of the pixel's ray cone when splats are in use.
+    #[inline]
+    fn gather_radius(&self, b: &Branch, hit: &Hit) -> Option<f32> {
+        match self.splats {
+            None => Some(f32::INFINITY),
+            Some(_) if b.depth == 0 => None,
+            Some(_) => Some(self.footprint * (b.travelled + hit.t)),
+        }
+    }
+
+    /// Light leaving `hit` towards the eye directly, and up to two specular branches;
+    /// the caustic part and the path's events go to `log`.
     #[inline]
     fn scatter(
         &self,
@@ -249,6 +359,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         hit: &Hit,
         material: &Material,
         count: &mut RayCount,
+        log: &mut Sample,
     ) -> (Rgb, Option<Branch>, Option<Branch>) {
         let d = b.ray.dir;
         let front = hit.front_face(d);
@@ -260,6 +371,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 ray: Ray::spawn(hit, dir),
                 weight: w,
                 depth: b.depth + 1,
+                travelled: b.travelled + hit.t,
             })
         };
         match material {
@@ -267,17 +379,21 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !front {
                     return (Rgb::ZERO, None, None);
                 }
-                let mut e = self.store.irradiance(hit.point, hit.normal);
+                let caustic = match self.gather_radius(b, hit) {
+                    Some(r) => self.store.irradiance_within(hit.point, hit.normal, r),
+                    None => Rgb::ZERO,
+                };
+                let mut e = caustic;
                 for light in self.scene.lights() {
-                    if let Some((l, irradiance)) = self.direct_one(hit, light, count) {
+                    let lit = self.direct_one(hit, light, count);
+                    log.mix(lit.is_some() as u32);
+                    if let Some((l, irradiance)) = lit {
                         e += irradiance * hit.normal.dot(l.get());
                     }
                 }
-                (
-                    b.weight * m.albedo * e * core::f32::consts::FRAC_1_PI,
-                    None,
-                    None,
-                )
+                let f = b.weight * m.albedo;
+                log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
+                (f * e * core::f32::consts::FRAC_1_PI, None, None)
             }
             Material::Mirror(m) if can_bounce => (
                 Rgb::ZERO,
@@ -300,7 +416,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(hit, c, -d, count)
+                    self.classic_local(b, hit, c, -d, count, log)
                 } else {
                     Rgb::ZERO
                 };
@@ -320,16 +436,31 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// The classic model's local part at a front-side hit seen from `to_eye`.
-    fn classic_local(&self, hit: &Hit, c: &Classic, to_eye: UnitVec3, count: &mut RayCount) -> Rgb {
+    fn classic_local(
+        &self,
+        b: &Branch,
+        hit: &Hit,
+        c: &Classic,
+        to_eye: UnitVec3,
+        count: &mut RayCount,
+        log: &mut Sample,
+    ) -> Rgb {
         let n = hit.normal;
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
-            if let Some((l, e)) = self.direct_one(hit, light, count) {
+            let seen = self.direct_one(hit, light, count);
+            log.mix(seen.is_some() as u32);
+            if let Some((l, e)) = seen {
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        ambient + lit + self.store.classic(hit.point, n, to_eye, c)
+        let caustic = match self.gather_radius(b, hit) {
+            Some(r) => self.store.classic_within(hit.point, n, to_eye, c, r),
+            None => Rgb::ZERO,
+        };
+        log.caustic += b.weight * caustic;
+        ambient + lit + caustic
     }
 
     /// Direction `l` and normal-incidence irradiance `I/d²` of one light if it shines
@@ -360,58 +491,5 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             return None;
         }
         Some((l, light.intensity() * (1.0 / d2)))
-    }
-
-    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width).
-    pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
-        let mut count = RayCount::default();
-        let camera = self.scene.camera();
-        let n = self.samples;
-        if n == 1 {
-            for (x, px) in row.iter_mut().enumerate() {
-                *px = self.radiance(camera.ray(x as u32, y), &mut count);
-            }
-            return count;
-        }
-        let (step, inv) = (1.0 / n as f32, 1.0 / (n * n) as f32);
-        for (x, px) in row.iter_mut().enumerate() {
-            let mut sum = Rgb::ZERO;
-            for sy in 0..n {
-                for sx in 0..n {
-                    let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
-                    sum += self.radiance(camera.ray_at(x as u32, y, fx, fy), &mut count);
-                }
-            }
-            *px = sum * inv;
-        }
-        count
-    }
-
-    /// Renders every row, top to bottom, into the caller's one-row buffer and hands each
-    /// to `sink` before the next is computed: no frame buffer. The sink receives exactly
-    /// `width` pixels (a longer buffer's tail is left alone).
-    ///
-    /// An error, before anything is rendered, when `row` is shorter than the image width
-    /// ([`RowsError::Render`] with [`Error::Capacity`]); otherwise stops at the sink's
-    /// first error and returns it ([`RowsError::Sink`]).
-    pub fn rows<E>(
-        &self,
-        row: &mut [Rgb],
-        mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
-    ) -> Result<RayCount, RowsError<E>> {
-        let mut count = RayCount::default();
-        let width = self.scene.camera().width() as usize;
-        let Some(row) = row.get_mut(..width) else {
-            return Err(RowsError::Render(Error::Capacity {
-                what: "row buffer (pixels of one image row)",
-                requested: width,
-                capacity: row.len(),
-            }));
-        };
-        for y in 0..self.scene.camera().height() {
-            count += self.row(y, row);
-            sink(y, row).map_err(RowsError::Sink)?;
-        }
-        Ok(count)
     }
 }
