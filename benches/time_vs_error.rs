@@ -200,7 +200,7 @@ fn measure(
             let t = Instant::now();
             let result = match c.estimator {
                 Estimator::IlluminationMap => {
-                    render_illumination(&scene, &settings, &opts, TEXEL).map(|r| r.0)
+                    render_illumination(&scene, &settings, &opts, TEXEL).map(|r| r.0.image)
                 }
                 _ => render(&scene, &settings, &opts).map(|r| r.0),
             };

@@ -300,13 +300,12 @@ mod tests {
     }
 
     #[test]
-    fn snell_law_and_energy_over_all_angles() {
+    fn snell_law_over_all_angles() {
         for eta in [1.0 / 1.5, 1.5, 1.0, 1.0 / 2.4] {
             for k in 0..=90 {
                 let theta = (k as f32).to_radians().min(core::f32::consts::FRAC_PI_2);
                 let f = interface(dir_at(theta), UnitVec3::Y, eta);
                 assert!((0.0..=1.0).contains(&f.reflectance));
-                // R + T = 1 by construction; T is what refraction carries.
                 if let Some(t) = f.refracted {
                     let sin_t = (t.get() - Vec3::Y * t.get().y).length();
                     assert!(
@@ -327,6 +326,93 @@ mod tests {
         // Grazing incidence reflects everything.
         let g = interface(dir_at(core::f32::consts::FRAC_PI_2), UnitVec3::Y, 1.0 / 1.5);
         assert!((g.reflectance - 1.0).abs() < 1e-6);
+    }
+
+    /// At Brewster's angle `tan θ_B = n` (from air into index `n`) the p-polarised
+    /// reflectance vanishes, so the unpolarised `F = ½ R_s = ½((n² − 1)/(n² + 1))²`.
+    #[test]
+    fn fresnel_at_brewster_angle_is_half_the_s_reflectance() {
+        for n in [1.33f64, 1.5, 2.4] {
+            let theta = libm::atan(n) as f32;
+            let f = interface(dir_at(theta), UnitVec3::Y, (1.0 / n) as f32).reflectance as f64;
+            let want = 0.5 * ((n * n - 1.0) / (n * n + 1.0)).powi(2);
+            assert!((f - want).abs() < 2e-6, "n = {n}: {f} vs {want}");
+            // And from inside, at the internal Brewster angle tan θ = 1/n.
+            let inside = libm::atan(1.0 / n) as f32;
+            let f = interface(dir_at(inside), UnitVec3::Y, n as f32).reflectance as f64;
+            assert!((f - want).abs() < 2e-6, "n = {n} inside: {f} vs {want}");
+        }
+    }
+
+    /// The hemispherical (cosine-weighted) reflectance `2∫₀^{π/2} F(θ) cos θ sin θ dθ`
+    /// of `interface`, integrated by the midpoint rule, against its closed form for
+    /// light from air (Stern 1964; the classic value 0.0918 at n = 1.5) and, from
+    /// inside, against `1 − (1 − r_e)/n²` (reciprocity; the total internal
+    /// reflection beyond the critical angle is most of it).
+    #[test]
+    fn hemispherical_reflectance_matches_the_closed_form() {
+        fn outside(n: f64) -> f64 {
+            let (n2, n4) = (n * n, n * n * n * n);
+            0.5 + (n - 1.0) * (3.0 * n + 1.0) / (6.0 * (n + 1.0).powi(2))
+                + n2 * (n2 - 1.0).powi(2) / (n2 + 1.0).powi(3) * libm::log((n - 1.0) / (n + 1.0))
+                - 2.0 * n * n2 * (n2 + 2.0 * n - 1.0) / ((n2 + 1.0) * (n4 - 1.0))
+                + 8.0 * n4 * (n4 + 1.0) / ((n2 + 1.0) * (n4 - 1.0).powi(2)) * libm::log(n)
+        }
+        fn integral(eta: f32) -> f64 {
+            let steps = 20_000;
+            let h = core::f64::consts::FRAC_PI_2 / steps as f64;
+            (0..steps)
+                .map(|i| {
+                    let theta = (i as f64 + 0.5) * h;
+                    let f = interface(dir_at(theta as f32), UnitVec3::Y, eta).reflectance;
+                    2.0 * f as f64 * libm::cos(theta) * libm::sin(theta) * h
+                })
+                .sum()
+        }
+        assert!((outside(1.5) - 0.0918).abs() < 1e-4);
+        for n in [1.33f64, 1.5, 2.4] {
+            let (re, ri) = (integral((1.0 / n) as f32), integral(n as f32));
+            let want = outside(n);
+            assert!((re - want).abs() < 1e-4, "n = {n}: {re} vs {want}");
+            let want = 1.0 - (1.0 - outside(n)) / (n * n);
+            assert!((ri - want).abs() < 1e-4, "n = {n} inside: {ri} vs {want}");
+        }
+    }
+
+    /// The paper's eq. 8 kernel against a hand computation. Normal `+y`, light at 45°
+    /// in the x–y plane (`n·l = cos 45° = √2/2`). Eye straight above: the half vector
+    /// lies at 22.5° from the normal, `n·h = cos 22.5°`. Eye at the mirror direction of
+    /// the light: `h = n`, full highlight. Light below the horizon: no diffuse part.
+    #[test]
+    fn classic_kernel_matches_a_hand_computation() {
+        let c = Classic::new(Rgb::new(0.5, 1.0, 0.25), 0.1, 0.8, 0.3, 4.0, 0.0, 0.0, 1.5);
+        let unit = |x: f32, y: f32| UnitVec3::new(Vec3::new(x, y, 0.0)).unwrap();
+        let (n, l) = (UnitVec3::Y, unit(1.0, 1.0));
+        let close = |got: Rgb, k: f64| {
+            for (g, col) in got.to_array().into_iter().zip([0.5f64, 1.0, 0.25]) {
+                assert!((g as f64 - col * k).abs() < 1e-6, "{got:?} vs {k}·color");
+            }
+        };
+        let cos45 = core::f64::consts::FRAC_1_SQRT_2;
+        let cos22 = libm::cos(core::f64::consts::PI / 8.0);
+        // 0.8·cos 45° + 0.3·cos⁴ 22.5° = 0.565685 + 0.218566.
+        close(
+            c.kernel(n, l, UnitVec3::Y),
+            0.8 * cos45 + 0.3 * cos22.powi(4),
+        );
+        close(c.kernel(n, l, unit(-1.0, 1.0)), 0.8 * cos45 + 0.3);
+        // A non-integer exponent goes through powf: cos^2.5 22.5°.
+        let c25 = Classic::new(Rgb::new(0.5, 1.0, 0.25), 0.1, 0.8, 0.3, 2.5, 0.0, 0.0, 1.5);
+        close(
+            c25.kernel(n, l, UnitVec3::Y),
+            0.8 * cos45 + 0.3 * cos22.powf(2.5),
+        );
+        // Light from below: the diffuse part is 0; the half vector of (1,−1) and (−1,1)
+        // is undefined (they cancel), so no highlight either.
+        close(c.kernel(n, unit(1.0, -1.0), unit(-1.0, 1.0)), 0.0);
+        // k_s = 0: diffuse only, whatever the eye.
+        let matte = Classic::new(Rgb::new(0.5, 1.0, 0.25), 0.1, 0.8, 0.0, 4.0, 0.0, 0.0, 1.5);
+        close(matte.kernel(n, l, unit(-1.0, 1.0)), 0.8 * cos45);
     }
 
     #[test]

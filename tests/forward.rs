@@ -1,6 +1,8 @@
 //! The forward pass against analytic answers: photon density, energy through glass,
 //! and projection maps against full-sphere emission.
 
+mod support;
+
 use std::f64::consts::PI;
 
 use caustic::camera::Camera;
@@ -9,9 +11,12 @@ use caustic::geometry::Shape;
 use caustic::light::PointLight;
 use caustic::material::{interface, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
-use caustic::photon::{self, balance, store_over, CausticStore, KdTree, Photon, PhotonSettings};
+use caustic::photon::{
+    self, balance, store_over, CausticStore, KdTree, NoCaustics, Photon, PhotonSettings,
+};
 use caustic::render::Renderer;
 use caustic::scene::Scene;
+use support::scene_text;
 
 /// Shoots, balances and returns the photons and their power unit.
 fn photons<const O: usize, const L: usize>(
@@ -142,16 +147,25 @@ fn flux_through_a_glass_slab_matches_fresnel_transmission() {
     assert!(stored < 4.0 * PI * intensity as f64);
 }
 
-/// The caustic term alone, as an image (direct light off), so that images compare
-/// the forward pass only.
+/// The caustic term alone, as an image: the render with the photon store minus the
+/// render of the same eye paths with no caustic store (direct light, which both
+/// contain bit for bit, cancels), so that images compare the forward pass only.
 fn caustic_image(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> (Image, u64) {
     let (map, unit, emitted) = photons(scene, settings, seed);
     let store = store_over::<1024>(KdTree::from_balanced(&map), unit, settings).unwrap();
-    let cam = scene.camera();
-    let mut img = Image::new(cam.width(), cam.height());
-    let r: Renderer<_, 64, 16, 32> = Renderer::new(scene, &store, settings.max_depth()).unwrap();
-    for (y, row) in img.pixels.chunks_mut(cam.width() as usize).enumerate() {
-        r.row(y as u32, row);
+    fn draw<S: CausticStore>(scene: &DesktopScene, store: &S, depth: u32) -> Image {
+        let cam = scene.camera();
+        let mut img = Image::new(cam.width(), cam.height());
+        let r: Renderer<_, 64, 16, 32> = Renderer::new(scene, store, depth).unwrap();
+        for (y, row) in img.pixels.chunks_mut(cam.width() as usize).enumerate() {
+            r.row(y as u32, row);
+        }
+        img
+    }
+    let depth = settings.max_depth();
+    let (mut img, direct) = (draw(scene, &store, depth), draw(scene, &NoCaustics, depth));
+    for (p, d) in img.pixels.iter_mut().zip(&direct.pixels) {
+        *p += *d * -1.0;
     }
     (img, emitted)
 }
@@ -161,11 +175,7 @@ fn caustic_image(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> 
 /// the objects, to within the noise between two seeds, for a fraction of the photons.
 #[test]
 fn projection_maps_match_full_sphere_emission_for_a_fraction_of_the_work() {
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/glass_sphere.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = scene_text("glass_sphere.json");
     let loaded = parse_scene(&text).unwrap();
     let mut scene = loaded.scene;
     // Only the caustic: light the floor with nothing else (a dark light would emit no
@@ -243,12 +253,9 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
 /// number of threads (so the image cannot depend on them).
 #[test]
 fn the_parallel_forward_pass_is_the_serial_one() {
-    use caustic::desktop::run::{PhotonBuffer, RenderStats};
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/two_balls.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    use caustic::desktop::photons::PhotonBuffer;
+    use caustic::desktop::RenderStats;
+    let text = scene_text("two_balls.json");
     let scene = parse_scene(&text).unwrap().scene;
     // Enough photons that the balance runs in parallel too (above 2^15 stored).
     let s = PhotonSettings::new(60_000, 16, 0.1, 8).unwrap();

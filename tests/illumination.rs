@@ -2,6 +2,8 @@
 //! from uniform flux, energy conservation, true texel areas, the single-photon round
 //! trip, determinism, and the streaming forward pass against `shoot`.
 
+mod support;
+
 use std::f64::consts::PI;
 
 use caustic::camera::Camera;
@@ -15,6 +17,7 @@ use caustic::photon::{
     PhotonSettings,
 };
 use caustic::scene::Scene;
+use support::{data_text, scene_text};
 
 type Maps = IlluminationMaps<Vec<Rgb>, 8>;
 
@@ -131,7 +134,7 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
 /// splatted + dropped equals what the forward pass stored, on a real caustic scene.
 #[test]
 fn total_energy_equals_the_energy_splatted() {
-    let text = std::fs::read_to_string("scenes/glass_sphere.json").unwrap();
+    let text = scene_text("glass_sphere.json");
     let loaded = parse_scene(&text).unwrap();
     let settings = PhotonSettings::new(20_000, 32, 0.1, 8).unwrap();
     let mut maps = IlluminationMaps::<Vec<Rgb>, 64>::new(Vec::new(), 0.05).unwrap();
@@ -301,7 +304,7 @@ fn single_photon_round_trip_conserves_energy() {
 /// array holds the same maps as a `Vec`.
 #[test]
 fn same_seed_same_bits_and_streaming_equals_stored() {
-    let text = std::fs::read_to_string("scenes/tube.json").unwrap();
+    let text = scene_text("tube.json");
     let loaded = parse_scene(&text).unwrap();
     let scene = &loaded.scene;
     let settings = PhotonSettings::new(5_000, 32, 0.1, 8).unwrap();
@@ -383,11 +386,7 @@ fn photons_from_behind_are_not_splatted() {
 /// budget, and a budget below one texel a chart is an error, not a truncation.
 #[test]
 fn a_layout_beyond_the_texel_budget_is_coarsened_to_fit() {
-    let text = std::fs::read_to_string(format!(
-        "{}/scenes/two_balls.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = scene_text("two_balls.json");
     let scene = caustic::desktop::parse_scene(&text).unwrap().scene;
     let settings = PhotonSettings::new(20_000, 16, 0.02, 8).unwrap();
     for budget in [100_000usize, 5_000, 64] {
@@ -432,15 +431,11 @@ fn a_layout_beyond_the_texel_budget_is_coarsened_to_fit() {
 /// within 15% of the kd-tree store's and within 2% of the photons that landed there.
 #[test]
 fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
-    use caustic::desktop::run::PhotonBuffer;
+    use caustic::desktop::photons::PhotonBuffer;
     use caustic::desktop::{RenderStats, MAX_GATHER, MAX_OBJECTS};
     use caustic::photon::DEFAULT_HEAP_TEXELS;
 
-    let text = std::fs::read_to_string(format!(
-        "{}/tests/data/glass_sphere_wall.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap();
+    let text = data_text("glass_sphere_wall.json");
     let loaded = parse_scene(&text).unwrap();
     let texel = match loaded.caustic_store {
         caustic::desktop::scene_file::StoreChoice::IlluminationMap { texel_size } => texel_size,
@@ -520,4 +515,44 @@ fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
         (e_maps - landed).abs() / landed < 0.05,
         "maps {e_maps}, landed {landed}"
     );
+}
+
+/// A photon carries the object it landed on, and the maps splat it there, not onto
+/// whichever surface lies nearest its position: two coincident planes, photons marked
+/// for the second go to the second. The forward pass marks every photon with the
+/// object it landed on.
+#[test]
+fn photons_are_splatted_on_the_object_they_landed_on() {
+    let plane = Shape::plane(Vec3::ZERO, Vec3::Y).unwrap();
+    let scene = scene_of(&[plane, plane]);
+    let photons: Vec<Photon> = (0..10)
+        .map(|i| Photon::new(Vec3::new(0.1 * i as f32, 0.0, 0.3), down(), Rgb::ONE).on_surface(1))
+        .collect();
+    let mut maps = Maps::new(Vec::new(), 0.1).unwrap().with_trim(0.0).unwrap();
+    let st = maps.build_from_photons(&scene, &photons, 1.0).unwrap();
+    assert_eq!(
+        (st.splatted_photons, maps.charts(0), maps.charts(1)),
+        (10, 0, 1)
+    );
+    // Unmarked, the nearest surface (the first of two at distance 0) takes them.
+    let unmarked: Vec<Photon> = photons
+        .iter()
+        .map(|p| Photon::new(p.position(), p.direction(), p.power()))
+        .collect();
+    maps.build_from_photons(&scene, &unmarked, 1.0).unwrap();
+    assert_eq!((maps.charts(0), maps.charts(1)), (1, 0));
+    // An index a photon cannot hold stays unknown.
+    assert_eq!(photons[0].on_surface(255).surface(), None);
+    assert_eq!(photons[0].on_surface(254).surface(), Some(254));
+
+    let loaded = parse_scene(&scene_text("glass_sphere.json")).unwrap();
+    let settings = PhotonSettings::new(2_000, 8, 0.1, 8).unwrap();
+    let mut n = 0;
+    for_each_photon(&loaded.scene, &settings, 1, 0, |p| {
+        // Object 0 is the floor; every photon lands on it (y = 0).
+        assert_eq!(p.surface(), Some(0));
+        assert!(p.position().y.abs() < 1e-5);
+        n += 1;
+    });
+    assert!(n > 1000);
 }

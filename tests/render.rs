@@ -1,9 +1,13 @@
 //! The backward pass end to end: analytic radiance, refraction geometry, determinism
 //! across threads, and the scene files' error messages.
 
+mod support;
+
 use caustic::camera::Camera;
 use caustic::desktop::image::compare;
-use caustic::desktop::run::{render_rows, PhotonBuffer, Progress};
+use caustic::desktop::photons::PhotonBuffer;
+use caustic::desktop::progress::Progress;
+use caustic::desktop::run::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
 use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Ray, Shape};
@@ -13,12 +17,10 @@ use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
 use caustic::photon;
 use caustic::photon::{NoCaustics, PhotonSettings};
+use caustic::render::PixelEstimate;
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
-
-fn read(name: &str) -> String {
-    std::fs::read_to_string(format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
-}
+use support::scene_text;
 
 /// A diffuse floor of albedo ρ under a point light: every pixel that sees the floor has
 /// radiance ρ·I·cosθ/(π·d²), evaluated here in f64 from the analytic ray–plane hit.
@@ -192,8 +194,12 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
                 .unwrap()
                 .with_ray_budget(budget)
                 .unwrap();
+        let mut frame = vec![PixelEstimate::default(); 64 * 48];
+        let rays = render_rows(&r, &mut frame, 64, 2, &Progress::new(false, 48));
         let mut img = caustic::desktop::Image::new(64, 48);
-        let rays = render_rows(&r, &mut img, 2, &Progress::new(false, 48));
+        for (p, f) in img.pixels.iter_mut().zip(&frame) {
+            *p = f.radiance;
+        }
         (img, rays)
     };
     let (pruned, pruned_rays) = image(DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET);
@@ -346,7 +352,7 @@ fn rows_refuses_a_short_row_buffer() {
 }
 
 fn small(name: &str, w: u32, h: u32) -> (DesktopScene, PhotonSettings) {
-    let loaded = parse_scene(&read(name)).unwrap();
+    let loaded = parse_scene(&scene_text(name)).unwrap();
     let mut scene = loaded.scene;
     scene.set_camera(scene.camera().with_size(w, h).unwrap());
     let p = loaded.photons;
@@ -411,15 +417,7 @@ fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
         ..RenderOptions::default()
     };
     let (a, sa) = render(&scene, &settings, &one).unwrap();
-    let (b, _) = render(
-        &scene,
-        &settings,
-        &RenderOptions {
-            threads: 4,
-            ..one.clone()
-        },
-    )
-    .unwrap();
+    let (b, _) = render(&scene, &settings, &RenderOptions { threads: 4, ..one }).unwrap();
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(sa.passes, 3);
     assert_eq!(sa.photons_emitted, 3 * settings.count() as u64);
@@ -428,7 +426,7 @@ fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
 /// The Fig. 6 scene the device builds in code is the scene in `scenes/fig6.json`.
 #[test]
 fn the_device_scene_is_the_scene_file() {
-    let file = parse_scene(&read("fig6.json")).unwrap().scene;
+    let file = parse_scene(&scene_text("fig6.json")).unwrap().scene;
     let code: DesktopScene = caustic::demo::fig6(320, 240).unwrap();
     assert_eq!(file.objects(), code.objects());
     assert_eq!(file.lights(), code.lights());
@@ -453,213 +451,242 @@ fn example_scenes_parse() {
 
 /// Applies `edit` to the glass-sphere scene's JSON and returns the parse error.
 fn error_after(edit: impl FnOnce(&mut serde_json::Value)) -> caustic::desktop::SceneError {
-    let mut v: serde_json::Value = serde_json::from_str(&read("glass_sphere.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&scene_text("glass_sphere.json")).unwrap();
     edit(&mut v);
     parse_scene(&v.to_string()).expect_err("must be rejected")
 }
 
+/// `(JSON pointer, new value)`: sets the value there (adding an object key if needed).
+fn set(pointer: &str, value: serde_json::Value) -> impl FnOnce(&mut serde_json::Value) {
+    let pointer = pointer.to_string();
+    move |v| {
+        let (parent, key) = pointer.rsplit_once('/').unwrap();
+        let p = v.pointer_mut(parent).unwrap();
+        match p {
+            serde_json::Value::Array(a) => a[key.parse::<usize>().unwrap()] = value,
+            serde_json::Value::Object(o) => {
+                o.insert(key.to_string(), value);
+            }
+            _ => panic!("{pointer}"),
+        }
+    }
+}
+
+/// Each `(pointer, value, path, message)`: the glass-sphere scene with that value set
+/// fails to parse, with an error at `path` whose message contains `message`.
+fn check_errors(cases: Vec<(&str, serde_json::Value, &str, &str)>) {
+    for (pointer, value, path, message) in cases {
+        let e = error_after(set(pointer, value));
+        assert_eq!(e.path, path, "{pointer}: {e}");
+        assert!(
+            e.message.contains(message),
+            "{pointer}: {e} (wanted “{message}”)"
+        );
+    }
+}
+
 #[test]
-fn every_scene_error_names_its_path_and_problem() {
+fn object_errors_name_their_path_and_problem() {
     use serde_json::json;
-    type Edit = Box<dyn FnOnce(&mut serde_json::Value)>;
-    let cases: Vec<(Edit, &str, &str)> = vec![
+    check_errors(vec![
+        ("/camra", json!(1), "camra", "unknown field `camra`"),
         (
-            Box::new(|v| v["camra"] = json!(1)),
-            "camra",
-            "unknown field `camra`",
-        ),
-        (
-            Box::new(|v| v["objects"][1]["radius"] = json!(0)),
+            "/objects/1/radius",
+            json!(0),
             "objects[1].radius",
             "must be positive",
         ),
         (
-            Box::new(|v| v["objects"][1]["radius"] = json!(-2.5)),
+            "/objects/1/radius",
+            json!(-2.5),
             "objects[1].radius",
             "must be positive",
         ),
         (
-            Box::new(|v| v["objects"][1]["radius"] = json!("big")),
+            "/objects/1/radius",
+            json!("big"),
             "objects[1].radius",
             "invalid type",
         ),
         (
-            Box::new(|v| v["objects"][1]["radius"] = json!(1e300)),
+            "/objects/1/radius",
+            json!(1e300),
             "objects[1].radius",
             "finite",
         ),
         (
-            Box::new(|v| v["objects"][1]["radus"] = json!(1)),
+            "/objects/1/radus",
+            json!(1),
             "objects[1].radus",
             "unknown field `radus`",
         ),
         (
-            Box::new(|v| {
-                v["objects"][1].as_object_mut().unwrap().remove("radius");
-            }),
-            "objects[1]",
-            "missing field `radius`",
-        ),
-        (
-            Box::new(|v| v["objects"][0]["type"] = json!("torus")),
+            "/objects/0/type",
+            json!("torus"),
             "objects[0].type",
             "unknown type \"torus\"",
         ),
         (
-            Box::new(|v| v["objects"][0]["normal"] = json!([0, 0, 0])),
+            "/objects/0/normal",
+            json!([0, 0, 0]),
             "objects[0].normal",
             "degenerate",
         ),
         (
-            Box::new(|v| v["objects"][1]["material"] = json!("glas")),
+            "/objects/1/material",
+            json!("glas"),
             "objects[1].material",
             "unknown material \"glas\"",
         ),
         (
-            Box::new(|v| v["objects"][1]["center"] = json!([0, 1])),
+            "/objects/1/center",
+            json!([0, 1]),
             "objects[1].center",
             "invalid length 2",
         ),
         (
-            Box::new(|v| {
-                v["objects"][1] = json!({"type": "box", "center": [0,0,0], "size": [1, 0, 1], "material": "glass"})
-            }),
+            "/objects/1",
+            json!({"type": "box", "center": [0,0,0], "size": [1, 0, 1], "material": "glass"}),
             "objects[1].size",
             "must be positive",
         ),
         (
-            Box::new(
-                |v| v["objects"][1] = json!({"type": "cylinder", "base": [0,0,0], "axis": [0,0,0], "radius": 1, "height": 1, "material": "glass"}),
-            ),
+            "/objects/1",
+            json!({"type": "cylinder", "base": [0,0,0], "axis": [0,0,0], "radius": 1,
+                   "height": 1, "material": "glass"}),
             "objects[1].axis",
             "degenerate",
         ),
         (
-            Box::new(|v| v["materials"]["glass"]["ior"] = json!(-1)),
-            "materials.glass.ior",
-            "must be positive",
-        ),
-        (
-            Box::new(|v| v["materials"]["floor"]["albedo"] = json!([1.5, 0, 0])),
-            "materials.floor.albedo",
-            "[0, 1]",
-        ),
-        (
-            Box::new(|v| v["materials"]["floor"]["type"] = json!("lambert")),
-            "materials.floor.type",
-            "unknown type",
-        ),
-        (
-            Box::new(|v| {
-                v["materials"]["c"] = json!({"type": "classic", "color": [1,1,1], "ambient": 0.1, "diffuse": 0.5,
-                "specular": 0.1, "shininess": 5, "reflectivity": 0.6, "transparency": 0.6, "ior": 1.2})
-            }),
-            "materials.c.reflectivity",
-            "reflectivity + transparency",
-        ),
-        (
-            Box::new(|v| v["lights"][0]["intensity"] = json!([-1, 0, 0])),
-            "lights[0].intensity",
-            "[0,",
-        ),
-        (
-            Box::new(|v| v["lights"][0]["type"] = json!("spot")),
-            "lights[0].type",
-            "unknown type \"spot\"",
-        ),
-        (
-            Box::new(|v| v["camera"]["look_at"] = json!([0, 4, 7])),
-            "camera.look_at",
-            "degenerate",
-        ),
-        (
-            Box::new(|v| v["camera"]["fov_y_deg"] = json!(180)),
-            "camera.fov_y_deg",
-            "[0.001, 179]",
-        ),
-        (
-            Box::new(|v| v["camera"]["up"] = json!([0, 0, 0])),
-            "camera.up",
-            "degenerate",
-        ),
-        (
-            Box::new(|v| v["image"]["width"] = json!(0)),
-            "image.width",
-            "must lie in [1,",
-        ),
-        (
-            Box::new(|v| v["image"]["height"] = json!(-3)),
-            "image.height",
-            "invalid value",
-        ),
-        (
-            Box::new(|v| v["photons"]["k"] = json!(0)),
-            "photons.k",
-            "must be positive",
-        ),
-        (
-            Box::new(|v| v["photons"]["k"] = json!(100_000)),
-            "photons.k",
-            "gather capacity",
-        ),
-        (
-            Box::new(|v| v["photons"]["max_radius"] = json!(0)),
-            "photons.max_radius",
-            "must be positive",
-        ),
-        (
-            Box::new(|v| v["photons"]["max_depth"] = json!(40)),
-            "photons.max_depth",
-            "path stack capacity",
-        ),
-        (
-            Box::new(|v| v["photons"]["max_depth"] = json!(1000)),
-            "photons.max_depth",
-            "[0, 255]",
-        ),
-        (
-            Box::new(|v| v["photons"]["gather"] = json!("knn")),
-            "photons.gather",
-            "unknown gather \"knn\"",
-        ),
-        (
-            Box::new(|v| v["photons"]["passes"] = json!(0)),
-            "photons.passes",
-            "at least 1",
-        ),
-        (
-            Box::new(|v| v["photons"]["alpha"] = json!(1.5)),
-            "photons.alpha",
-            "(0, 1)",
-        ),
-        (
-            Box::new(|v| v["photons"]["count"] = json!(-5)),
-            "photons.count",
-            "invalid value",
-        ),
-        (
-            Box::new(|v| v["photons"]["caustic_store"] = json!({"type": "octree"})),
-            "photons.caustic_store.type",
-            "unknown type",
-        ),
-        (
-            Box::new(|v| v["background"] = json!([0, f64::MAX, 0])),
+            "/background",
+            json!([0, f64::MAX, 0]),
             "background",
             "finite",
         ),
-    ];
-    for (i, (edit, path, message)) in cases.into_iter().enumerate() {
-        let e = error_after(edit);
-        assert_eq!(e.path, path, "case {i}: {e}");
-        assert!(
-            e.message.contains(message),
-            "case {i}: {e} (wanted “{message}”)"
-        );
-    }
+    ]);
+    let e = error_after(|v| {
+        v["objects"][1].as_object_mut().unwrap().remove("radius");
+    });
+    assert_eq!(e.path, "objects[1]", "{e}");
+    assert!(e.message.contains("missing field `radius`"), "{e}");
     let e = parse_scene("{ \"camera\": ").unwrap_err();
     assert!(e.message.starts_with("invalid JSON"), "{e}");
     let e = parse_scene("[1, 2]").unwrap_err();
     assert!(e.message.contains("invalid type"), "{e}");
+}
+
+#[test]
+fn material_and_light_errors_name_their_path_and_problem() {
+    use serde_json::json;
+    let classic = json!({"type": "classic", "color": [1,1,1], "ambient": 0.1, "diffuse": 0.5,
+        "specular": 0.1, "shininess": 5, "reflectivity": 0.6, "transparency": 0.6, "ior": 1.2});
+    check_errors(vec![
+        (
+            "/materials/glass/ior",
+            json!(-1),
+            "materials.glass.ior",
+            "must be positive",
+        ),
+        (
+            "/materials/floor/albedo",
+            json!([1.5, 0, 0]),
+            "materials.floor.albedo",
+            "[0, 1]",
+        ),
+        (
+            "/materials/floor/type",
+            json!("lambert"),
+            "materials.floor.type",
+            "unknown type",
+        ),
+        (
+            "/materials/c",
+            classic,
+            "materials.c.reflectivity",
+            "reflectivity + transparency",
+        ),
+        (
+            "/lights/0/intensity",
+            json!([-1, 0, 0]),
+            "lights[0].intensity",
+            "[0,",
+        ),
+        (
+            "/lights/0/type",
+            json!("spot"),
+            "lights[0].type",
+            "unknown type \"spot\"",
+        ),
+    ]);
+}
+
+#[test]
+fn camera_and_image_errors_name_their_path_and_problem() {
+    use serde_json::json;
+    check_errors(vec![
+        (
+            "/camera/look_at",
+            json!([0, 4, 7]),
+            "camera.look_at",
+            "degenerate",
+        ),
+        (
+            "/camera/fov_y_deg",
+            json!(180),
+            "camera.fov_y_deg",
+            "[0.001, 179]",
+        ),
+        ("/camera/up", json!([0, 0, 0]), "camera.up", "degenerate"),
+        ("/image/width", json!(0), "image.width", "must lie in [1,"),
+        ("/image/height", json!(-3), "image.height", "invalid value"),
+    ]);
+}
+
+#[test]
+fn photon_errors_name_their_path_and_problem() {
+    use serde_json::json;
+    check_errors(vec![
+        ("/photons/k", json!(0), "photons.k", "must be positive"),
+        ("/photons/k", json!(100_000), "photons.k", "gather capacity"),
+        (
+            "/photons/max_radius",
+            json!(0),
+            "photons.max_radius",
+            "must be positive",
+        ),
+        (
+            "/photons/max_depth",
+            json!(40),
+            "photons.max_depth",
+            "path stack capacity",
+        ),
+        (
+            "/photons/max_depth",
+            json!(1000),
+            "photons.max_depth",
+            "[0, 255]",
+        ),
+        (
+            "/photons/gather",
+            json!("knn"),
+            "photons.gather",
+            "unknown gather \"knn\"",
+        ),
+        ("/photons/passes", json!(0), "photons.passes", "at least 1"),
+        ("/photons/alpha", json!(1.5), "photons.alpha", "(0, 1)"),
+        (
+            "/photons/count",
+            json!(-5),
+            "photons.count",
+            "invalid value",
+        ),
+        (
+            "/photons/caustic_store",
+            json!({"type": "octree"}),
+            "photons.caustic_store.type",
+            "unknown type",
+        ),
+    ]);
 }
 
 /// The program exits with status 2 and names the JSON path on bad input; on good input
@@ -671,7 +698,7 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     let bad = dir.join("bad.json");
     std::fs::write(
         &bad,
-        read("glass_sphere.json").replace("\"radius\": 1.0", "\"radius\": 0"),
+        scene_text("glass_sphere.json").replace("\"radius\": 1.0", "\"radius\": 0"),
     )
     .unwrap();
     let exe = env!("CARGO_BIN_EXE_caustic");
@@ -688,7 +715,16 @@ fn the_program_reports_bad_input_with_exit_status_2() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(dir).ok();
+}
 
+/// The program renders what the library renders: its PFM holds the library's bits, its
+/// `--stats` the sizes and counts, and `compare` measures a known difference.
+#[test]
+fn the_program_writes_the_library_image_and_compares_it() {
+    let dir = std::env::temp_dir().join(format!("caustic-cli-ok-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = env!("CARGO_BIN_EXE_caustic");
     let scene = format!("{}/scenes/glass_sphere.json", env!("CARGO_MANIFEST_DIR"));
     let (png, pfm) = (dir.join("g.png"), dir.join("g.pfm"));
     let out = std::process::Command::new(exe)
@@ -728,13 +764,48 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
     let img = caustic::desktop::Image::read_pfm(&pfm).unwrap();
     assert_eq!((img.width, img.height), (40, 30));
+    // The PFM holds exactly the image the library renders from the same file and flags
+    // (seed 0, the file's gather): the program adds nothing and the PFM round trip
+    // loses no bit.
+    let loaded = parse_scene(&scene_text("glass_sphere.json")).unwrap();
+    let mut want_scene = loaded.scene;
+    want_scene.set_camera(want_scene.camera().with_size(40, 30).unwrap());
+    let p = loaded.photons;
+    let want_settings = PhotonSettings::new(5000, p.k(), p.max_radius(), p.max_depth())
+        .unwrap()
+        .with_fixed_radius(p.fixed_radius());
+    let (want, _) = render(&want_scene, &want_settings, &RenderOptions::default()).unwrap();
+    assert_eq!(bits(&img), bits(&want));
+    // `compare` against a copy whose every value is ×1.25: the relative RMSE of a
+    // uniform scaling a·x vs x is |a − 1|·√mean(x²)/mean(x).
+    let mut scaled = img.clone();
+    for p in &mut scaled.pixels {
+        *p = *p * 1.25;
+    }
+    let scaled_path = dir.join("scaled.pfm");
+    scaled.write_pfm(&scaled_path).unwrap();
     let cmp = std::process::Command::new(exe)
         .args(["compare"])
-        .arg(&pfm)
+        .arg(&scaled_path)
         .arg(&pfm)
         .output()
         .unwrap();
+    assert!(
+        cmp.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cmp.stderr)
+    );
     let c: serde_json::Value = serde_json::from_slice(&cmp.stdout).unwrap();
-    assert_eq!(c["rel_rmse"].as_f64(), Some(0.0));
+    let values: Vec<f64> = img
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array().map(f64::from))
+        .collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let rms = (values.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+    let want = 0.25 * rms / mean;
+    let got = c["rel_rmse"].as_f64().unwrap();
+    assert!((got - want).abs() < 1e-6 * want, "{got} vs {want}");
     std::fs::remove_dir_all(dir).ok();
 }

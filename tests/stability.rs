@@ -5,17 +5,26 @@
 //! Case counts are moderate for CI. Longer runs:
 //! `PROPTEST_CASES=100000 cargo test --release --test stability` (every property), and
 //! `CAUSTIC_STRESS_SCENES=10000 cargo test --release --test stability random_scenes`
-//! (the random-scene count; default 300). See `docs/stability.md`.
+//! (the random-scene count; CI runs the default 300). Scenes built to be slow are in
+//! `tests/hostile.rs`. See `docs/stability.md`.
+
+mod support;
 
 use caustic::camera::Camera;
+use caustic::desktop::progress::Progress;
+use caustic::desktop::run::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
+use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Hit, Ray, Shape};
 use caustic::light::PointLight;
 use caustic::material::{interface, Classic, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
-use caustic::photon::{self, Photon, PhotonSettings};
+use caustic::photon::{self, NoCaustics, Photon, PhotonSettings};
+use caustic::render::PixelEstimate;
+use caustic::render::{Renderer, DEFAULT_RAY_BUDGET};
 use proptest::prelude::*;
 use serde_json::Value;
+use support::{scene_text, Rng};
 
 // ---------------------------------------------------------------------------------
 // Shapes: an independent f64 oracle for each.
@@ -488,10 +497,6 @@ fn translate(shape: &Shape, off: Vec3) -> Shape {
 // Whole renders: scale and translation invariance.
 // ---------------------------------------------------------------------------------
 
-fn scene_text(name: &str) -> String {
-    std::fs::read_to_string(format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
-}
-
 const SCENES: [&str; 4] = [
     "fig6.json",
     "glass_sphere.json",
@@ -643,49 +648,14 @@ fn translation_far_from_the_origin_is_measured() {
 // Random scenes.
 // ---------------------------------------------------------------------------------
 
-/// SplitMix64: a tiny deterministic generator for the scene fuzzer.
-struct Rng(u64);
-
-impl Rng {
-    fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f32 {
-        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.f()
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.u64() % n
-    }
-    fn chance(&mut self, p: f32) -> bool {
-        self.f() < p
-    }
-    fn v(&mut self, e: f32) -> Vec3 {
-        Vec3::new(self.range(-e, e), self.range(-e, e), self.range(-e, e))
-    }
-    fn rgb(&mut self, max: f32) -> Rgb {
-        Rgb::new(
-            self.range(0.0, max),
-            self.range(0.0, max),
-            self.range(0.0, max),
-        )
-    }
-    /// Mostly ordinary values, sometimes the edges of the allowed range.
-    fn ior(&mut self) -> f32 {
-        match self.below(8) {
-            0 => 1.0,
-            1 => [1e-3, 0.5, 100.0, 1e4][self.below(4) as usize],
-            _ => self.range(1.0, 2.5),
-        }
+/// Mostly ordinary values, sometimes the edges of the allowed range.
+fn ior(rng: &mut Rng) -> f32 {
+    match rng.below(8) {
+        0 => 1.0,
+        1 => [1e-3, 0.5, 100.0, 1e4][rng.below(4) as usize],
+        _ => rng.range(1.0, 2.5),
     }
 }
-
 fn random_material(rng: &mut Rng, s: f32) -> Material {
     match rng.below(5) {
         0 => Material::diffuse(rng.rgb(1.0)),
@@ -696,7 +666,7 @@ fn random_material(rng: &mut Rng, s: f32) -> Material {
             } else {
                 rng.rgb(3.0) * (1.0 / s)
             };
-            Material::dielectric(rng.ior(), absorption)
+            Material::dielectric(ior(rng), absorption)
         }
         _ => {
             let reflectivity = rng.f();
@@ -713,7 +683,7 @@ fn random_material(rng: &mut Rng, s: f32) -> Material {
                 },
                 reflectivity,
                 transparency,
-                rng.ior(),
+                ior(rng),
             ))
         }
     }
@@ -833,8 +803,22 @@ fn check_random_scene(seed: u64) -> Option<usize> {
         passes: 1 + (seed % 2) as u32,
         ..RenderOptions::default()
     };
-    let (image, _) =
+    let t = std::time::Instant::now();
+    let (image, stats) =
         render(&scene, &settings, &opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+    // The work is bounded by the ray budget per pixel and pass (deterministic), and —
+    // a safety net only — an 8×6 render takes well under 2 s even at opt-level 1.
+    let rays = stats.rays.eye + stats.rays.shadow;
+    let per_pixel = opts.sampling.max_rays_per_pixel(DEFAULT_RAY_BUDGET);
+    assert!(
+        rays <= 48 * per_pixel * opts.passes as u64,
+        "seed {seed}: {rays}"
+    );
+    assert!(
+        t.elapsed().as_secs_f64() < 2.0,
+        "seed {seed}: {:?}",
+        t.elapsed()
+    );
     for p in &image.pixels {
         assert!(
             p.is_finite() && p.min_channel() >= 0.0,
@@ -1100,20 +1084,47 @@ fn a_zero_power_light() {
     )
     .unwrap();
     assert!(image.pixels.iter().all(|p| *p == Rgb::ZERO));
-    // A dark light beside a bright one changes nothing.
-    scene
-        .add_light(PointLight::new(Vec3::new(2.0, 5.0, 0.0), Rgb::splat(50.0)).unwrap())
-        .unwrap();
+    // A dark light beside a bright one changes nothing: wherever it is, the image is
+    // the same bits; only the bright light emits; and direct light alone (no caustic
+    // store) is the bits of the scene without the dark light, at the same ray count.
+    let bright = PointLight::new(Vec3::new(2.0, 5.0, 0.0), Rgb::splat(50.0)).unwrap();
+    let opts = RenderOptions {
+        threads: 1,
+        ..RenderOptions::default()
+    };
+    scene.add_light(bright).unwrap();
     let f = photon::shoot(&scene, &settings, 0, 0, &mut vec![Photon::ZERO; 2000]).unwrap();
     assert!(f.stored > 0 && f.power_unit.is_finite());
-    let (image, _) = render(
-        &scene,
-        &settings,
-        &RenderOptions {
-            threads: 1,
-            ..RenderOptions::default()
-        },
-    )
-    .unwrap();
+    assert_eq!(f.emitted, settings.count() as u64);
+    let (image, stats) = render(&scene, &settings, &opts).unwrap();
     assert!(image.pixels.iter().all(|p| p.is_finite()));
+    assert!(image.pixels.iter().any(|p| p.g > 0.0));
+    let mut moved = DesktopScene::new(*scene.camera());
+    for o in scene.objects() {
+        moved.add(o.shape, o.material).unwrap();
+    }
+    // The dark light inside the glass sphere now.
+    moved
+        .add_light(PointLight::new(Vec3::new(0.0, 1.0, 0.0), Rgb::ZERO).unwrap())
+        .unwrap();
+    moved.add_light(bright).unwrap();
+    let (image2, stats2) = render(&moved, &settings, &opts).unwrap();
+    assert!(image.pixels == image2.pixels && stats.rays == stats2.rays);
+    let mut alone = DesktopScene::new(*scene.camera());
+    for o in scene.objects() {
+        alone.add(o.shape, o.material).unwrap();
+    }
+    alone.add_light(bright).unwrap();
+    let direct = |sc: &DesktopScene| {
+        let r: Renderer<'_, _, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+            Renderer::new(sc, &NoCaustics, settings.max_depth()).unwrap();
+        let mut frame = vec![PixelEstimate::default(); 16 * 12];
+        let rays = render_rows(&r, &mut frame, 16, 1, &Progress::new(false, 0));
+        let mut img = caustic::desktop::Image::new(16, 12);
+        for (p, f) in img.pixels.iter_mut().zip(&frame) {
+            *p = f.radiance;
+        }
+        (img.pixels, rays)
+    };
+    assert_eq!(direct(&scene), direct(&alone));
 }

@@ -12,12 +12,14 @@
 #[cfg_attr(docsrs, doc(cfg(feature = "cli")))]
 pub mod cli;
 pub mod image;
+pub mod photons;
+pub mod progress;
 pub mod run;
 pub mod scene_file;
 pub mod settings;
 
 pub use image::Image;
-pub use run::{render, RenderOptions, RenderStats};
+pub use run::{render, render_with_error, ErrorEstimate, RenderOptions, RenderStats, Rendered};
 pub use scene_file::{load_scene, parse_scene, LoadedScene, SceneError};
 pub use settings::{SettingsInput, StoreChoice};
 

@@ -1,26 +1,26 @@
-//! Rendering on the desktop: the photon array on the heap, rows over threads, progress.
+//! Rendering on the desktop: passes of the forward pass ([`super::photons`]) and of the
+//! backward pass (rows over threads), each pixel with its estimated error.
 //!
 //! Rows are pure functions of `(scene, store, y)`, and the forward pass a pure function
 //! of `(scene, settings, seed, pass)`, so the image is bit-identical whatever the
 //! number of threads: threads only change the order in which rows are computed.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use std::vec;
 
+use serde::Serialize;
+
 use super::image::Image;
-use super::{DesktopScene, MAX_DEPTH, MAX_GATHER, MAX_PHOTONS};
+use super::photons::{desktop_budget, PhotonBuffer};
+use super::progress::Progress;
+use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::photon::{
-    self, add_to_frame, balance, photons_needed, CausticStore, Emitter, KdTree, Landed, Photon,
-    PhotonSettings, Splat,
-};
-use crate::render::{RayCount, Renderer, Sampling, REFINE};
-use crate::scene::Scene;
+use crate::photon::{self, add_to_frame, CausticStore, Photon, PhotonSettings, Splat};
+use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
 use crate::Error;
 
 /// How to render on the desktop.
@@ -42,15 +42,17 @@ pub struct RenderOptions {
     /// `image.max_rays_per_sample`; issue 16): see [`Renderer::with_ray_budget`].
     /// `None`: [`DEFAULT_RAY_BUDGET`](crate::render::DEFAULT_RAY_BUDGET).
     pub max_rays_per_sample: Option<u32>,
-    /// Where to write the per-pixel estimated error as PFM (`--error-map`; issue 13).
-    /// Not yet read by [`render`].
+    /// Where the program writes the per-pixel estimated error as PFM (`--error-map`;
+    /// see [`render_with_error`]).
     pub error_map: Option<PathBuf>,
     /// Render passes until the estimated relative RMSE is at most this, > 0
-    /// (`--target-error`; issue 13), instead of a fixed budget. Not yet read by
-    /// [`render`].
+    /// (`--target-error`), instead of a fixed number of passes: see
+    /// [`render_with_error`].
     pub target_error: Option<f32>,
-    /// With `target_error`: stop after this many seconds, > 0 (`--time-limit`), even
-    /// if the target is not reached. Not yet read by [`render`].
+    /// With `target_error`: start no pass after this many seconds, > 0
+    /// (`--time-limit`), even if the target is not reached (reported in
+    /// [`ErrorEstimate::time_limited`]; the only input that can change the image from
+    /// one run to the next).
     pub time_limit: Option<f64>,
 }
 
@@ -103,6 +105,40 @@ pub struct RenderStats {
     pub photons_stored: u64,
     /// Photons the camera sees directly, splatted into their pixels (all passes).
     pub photons_splatted: u64,
+    /// What the render estimates its own error to be.
+    pub error: ErrorEstimate,
+}
+
+/// What a render estimates its own error to be (see [`crate::render::PixelEstimate`]):
+/// the relative RMSE `sqrt(mean((a − b)²))/mean(b)` of the image `a` against the
+/// converged image `b`, over pixels and channels, from the halves of each pass's
+/// photons and the checkerboard halves of each supersampled pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorEstimate {
+    /// Over the whole image; `None` for a black image.
+    pub rel_rmse: Option<f64>,
+    /// Over the pixels whose caustic part is at least a tenth of their luminance;
+    /// `None` when there are none.
+    pub rel_rmse_caustic: Option<f64>,
+    /// Pixels in that caustic region.
+    pub caustic_pixels: u64,
+    /// The `--target-error` asked for, if any.
+    pub target: Option<f32>,
+    /// With a target: whether the estimate reached it.
+    pub reached: Option<bool>,
+    /// With a target: the time limit stopped the passes first.
+    pub time_limited: bool,
+}
+
+impl ErrorEstimate {
+    fn from_tally(t: &ErrorTally) -> Self {
+        Self {
+            rel_rmse: t.rel_rmse(),
+            rel_rmse_caustic: t.rel_rmse_caustic(),
+            caustic_pixels: t.caustic_pixels(),
+            ..Self::default()
+        }
+    }
 }
 
 /// A store that times its gathers (summed over threads).
@@ -111,250 +147,173 @@ struct Timed<'a, S> {
     nanos: AtomicU64,
 }
 
-impl<S: CausticStore> CausticStore for Timed<'_, S> {
-    fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
+impl<S> Timed<'_, S> {
+    fn time<T>(&self, f: impl FnOnce() -> T) -> T {
         let t = Instant::now();
-        let e = self.inner.irradiance(x, n);
+        let v = f();
         self.nanos
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
-        e
-    }
-    fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        let t = Instant::now();
-        let e = self.inner.classic(x, n, to_eye, m);
-        self.nanos
-            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
-        e
+        v
     }
 }
 
-fn ms(d: Duration) -> f64 {
+impl<S: CausticStore> CausticStore for Timed<'_, S> {
+    fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
+        self.time(|| self.inner.irradiance(x, n))
+    }
+    fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
+        self.time(|| self.inner.classic(x, n, to_eye, m))
+    }
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, r: f32) -> Rgb {
+        self.time(|| self.inner.irradiance_within(x, n, r))
+    }
+    fn classic_within(&self, x: Vec3, n: UnitVec3, e: UnitVec3, m: &Classic, r: f32) -> Rgb {
+        self.time(|| self.inner.classic_within(x, n, e, m, r))
+    }
+}
+
+pub(super) fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// The photon array of the forward pass, on the heap: allocated once for a budget and
-/// refilled in place by every progressive pass (fixed memory, Knaus & Zwicker 2011).
-#[derive(Debug)]
-pub struct PhotonBuffer {
-    photons: vec::Vec<Photon>,
-    len: usize,
-    unit: f32,
-    splats: vec::Vec<Splat>,
+/// A finished render: the image, its per-pixel estimated error (the square root of
+/// [`PixelEstimate::error2`] per channel) and what it did.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// Linear radiance.
+    pub image: Image,
+    /// Estimated error of each pixel and channel, the same units.
+    pub error: Image,
+    /// Statistics, with [`RenderStats::error`].
+    pub stats: RenderStats,
 }
 
-/// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
-/// [`MAX_PHOTONS`].
-fn desktop_budget<const O: usize, const L: usize>(
-    scene: &Scene<O, L>,
-    settings: &PhotonSettings,
-) -> Result<usize, Error> {
-    let needed = photons_needed(scene, settings);
-    if needed > MAX_PHOTONS {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: MAX_PHOTONS,
-        });
-    }
-    Ok(needed)
+/// Frames of pixel estimates summed over passes. The mean of `P` passes has the
+/// caustic light tracer's squared error `Σ_p split_p²/P²` (the passes are independent)
+/// and the sampling error of one pass (every pass samples the same sub-pixel grid).
+struct Passes {
+    width: usize,
+    radiance: vec::Vec<Rgb>,
+    caustic: vec::Vec<Rgb>,
+    split2: vec::Vec<Rgb>,
+    sampling2: vec::Vec<Rgb>,
+    count: u32,
 }
 
-/// Balances the kd-tree on `threads` threads: the top levels on this one, then the
-/// subtrees below them — disjoint ranges of the array — on all, then the permutation
-/// into heap order. The same array as [`balance`], bit for bit.
-fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress: &Progress) {
-    // Below this a thread costs more than it saves.
-    const SERIAL: usize = 1 << 15;
-    if threads <= 1 || photons.len() < SERIAL {
-        progress.phase(pass, "balance", 1);
-        balance(photons);
-        progress.tick();
-        return;
-    }
-    let n = photons.len();
-    let mut subtrees = vec::Vec::new();
-    // Four subtrees per thread, rounded up to a level: balances the load.
-    let levels = usize::BITS - (4 * threads - 1).leading_zeros();
-    progress.phase(pass, "balance", 0);
-    photon::balance_top(photons, levels, |t| subtrees.push(t));
-    subtrees.sort_by_key(|t| t.lo);
-    progress.set_steps(subtrees.len());
-    // Cut the array into the subtrees' disjoint slices.
-    let mut work = vec::Vec::with_capacity(subtrees.len());
-    let mut rest = &mut *photons;
-    let mut at = 0;
-    for t in subtrees {
-        let (_, tail) = rest.split_at_mut(t.lo - at);
-        let (slice, tail) = tail.split_at_mut(t.hi - t.lo);
-        work.push((slice, t));
-        rest = tail;
-        at = t.hi;
-    }
-    let work = Mutex::new(work);
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
-                let Some((slice, t)) = next else { break };
-                photon::balance_subtree(slice, n, t);
-                progress.tick();
-            });
+impl Passes {
+    fn new(width: usize, pixels: usize) -> Self {
+        let zero = || vec![Rgb::ZERO; pixels];
+        Self {
+            width,
+            radiance: zero(),
+            caustic: zero(),
+            split2: zero(),
+            sampling2: zero(),
+            count: 0,
         }
-    });
-    // Every subtree is partitioned, and the slices' borrow of `photons` is over.
-    drop(work);
-    photon::balance_finish(photons);
-}
-
-/// Photons traced per work item of the parallel forward pass. Fixed, so that the order
-/// of the stored photons — and so the tree and the image — does not depend on the
-/// number of threads.
-const CHUNK: u32 = 4096;
-
-impl PhotonBuffer {
-    /// Room for one forward pass of `settings` over `scene`; an error beyond
-    /// [`MAX_PHOTONS`].
-    pub fn for_budget<const O: usize, const L: usize>(
-        scene: &Scene<O, L>,
-        settings: &PhotonSettings,
-    ) -> Result<Self, Error> {
-        let needed = desktop_budget(scene, settings)?;
-        Ok(Self {
-            photons: vec![Photon::ZERO; needed],
-            len: 0,
-            unit: 0.0,
-            splats: vec::Vec::new(),
-        })
     }
 
-    /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
-    /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// `CHUNK` and kept in emission order: the same array as the core's
-    /// [`photon::shoot`], whatever the thread count.
-    pub fn fill<const O: usize, const L: usize>(
-        &mut self,
-        scene: &Scene<O, L>,
-        settings: &PhotonSettings,
-        seed: u64,
-        pass: u32,
-        threads: usize,
-        stats: &mut RenderStats,
-    ) -> Result<(), Error> {
-        let hidden = Progress::new(false, 1);
-        self.fill_with_progress(scene, settings, seed, pass, threads, stats, &hidden)
-    }
-
-    /// [`PhotonBuffer::fill`], showing its two phases (photons, balance) on `progress`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn fill_with_progress<const O: usize, const L: usize>(
-        &mut self,
-        scene: &Scene<O, L>,
-        settings: &PhotonSettings,
-        seed: u64,
-        pass: u32,
-        threads: usize,
-        stats: &mut RenderStats,
-        progress: &Progress,
-    ) -> Result<(), Error> {
-        let needed = photons_needed(scene, settings);
-        if needed > self.photons.len() {
-            return Err(Error::Capacity {
-                what: "photons (count × lights)",
-                requested: needed,
-                capacity: self.photons.len(),
-            });
+    fn add(&mut self, frame: &[PixelEstimate]) {
+        for (i, p) in frame.iter().enumerate() {
+            self.radiance[i] += p.radiance;
+            self.caustic[i] += p.caustic;
+            self.split2[i] += p.split * p.split;
+            self.sampling2[i] += p.sampling2;
         }
-        let t = Instant::now();
-        let emitter = Emitter::new(scene, settings, seed, pass);
-        let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())
-            .flat_map(|l| {
-                let n = emitter.count(l);
-                (0..n)
-                    .step_by(CHUNK as usize)
-                    .map(move |s| (l, s, (s + CHUNK).min(n)))
-            })
-            .collect();
-        progress.phase(pass, "photons", items.len());
-        let results: vec::Vec<Mutex<vec::Vec<Landed>>> =
-            items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
-        let next = AtomicUsize::new(0);
-        std::thread::scope(|scope| {
-            for _ in 0..threads.clamp(1, items.len().max(1)) {
-                scope.spawn(|| loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&(l, start, end)) = items.get(k) else {
-                        break;
-                    };
-                    let local: vec::Vec<Landed> =
-                        (start..end).filter_map(|i| emitter.land(l, i)).collect();
-                    if let Ok(mut slot) = results[k].lock() {
-                        *slot = local;
-                    }
-                    progress.tick();
-                });
-            }
-        });
-        let mut stored = 0;
-        self.splats.clear();
-        for r in results {
-            for x in r.into_inner().unwrap_or_default() {
-                self.photons[stored] = x.photon;
-                stored += 1;
-                self.splats.extend(x.splat);
-            }
+        self.count += 1;
+    }
+
+    /// Pixel `i` of the mean of the passes so far; its `split` is the root of the
+    /// passes' summed squares over `P` (a magnitude, the sign is gone).
+    fn pixel(&self, i: usize) -> PixelEstimate {
+        let inv = 1.0 / self.count.max(1) as f32;
+        let s = self.split2[i];
+        PixelEstimate {
+            radiance: self.radiance[i] * inv,
+            caustic: self.caustic[i] * inv,
+            split: Rgb::new(libm::sqrtf(s.r), libm::sqrtf(s.g), libm::sqrtf(s.b)) * inv,
+            sampling2: self.sampling2[i] * inv,
         }
-        stats.emit_ms += ms(t.elapsed());
-        let t = Instant::now();
-        balance_parallel(&mut self.photons[..stored], threads, pass, progress);
-        stats.balance_ms += ms(t.elapsed());
-        stats.photons_emitted += emitter.emitted();
-        stats.photons_stored += stored as u64;
-        stats.photons_splatted += self.splats.len() as u64;
-        self.len = stored;
-        self.unit = emitter.power_unit();
-        Ok(())
     }
 
-    /// The balanced tree of the last pass.
-    pub fn tree(&self) -> KdTree<'_> {
-        KdTree::from_balanced(&self.photons[..self.len])
+    /// The error tally of the mean, row by row (the device's order).
+    fn tally(&self) -> ErrorTally {
+        let mut t = ErrorTally::default();
+        let mut row = vec::Vec::with_capacity(self.width);
+        for start in (0..self.radiance.len()).step_by(self.width.max(1)) {
+            row.clear();
+            row.extend((start..start + self.width).map(|i| self.pixel(i)));
+            t.add_row(&row);
+        }
+        t
     }
 
-    /// Power of one stored unit, W.
-    pub fn unit(&self) -> f32 {
-        self.unit
-    }
-
-    /// The camera splats of the last pass, in emission order.
-    pub fn splats(&self) -> &[Splat] {
-        &self.splats
+    fn images(&self, w: u32, h: u32) -> (Image, Image) {
+        let (mut image, mut error) = (Image::new(w, h), Image::new(w, h));
+        for i in 0..self.radiance.len() {
+            let p = self.pixel(i);
+            let e = p.error2();
+            image.pixels[i] = p.radiance;
+            error.pixels[i] = Rgb::new(libm::sqrtf(e.r), libm::sqrtf(e.g), libm::sqrtf(e.b));
+        }
+        (image, error)
     }
 }
 
-/// Renders `scene` with the forward and backward passes, on `opts.threads` threads.
+/// Most passes `--target-error` renders.
+pub const MAX_TARGET_PASSES: u32 = 256;
+
+/// Renders `scene` with the forward and backward passes, on `opts.threads` threads:
+/// [`render_with_error`] without the error image.
 pub fn render(
     scene: &DesktopScene,
     settings: &PhotonSettings,
     opts: &RenderOptions,
 ) -> Result<(Image, RenderStats), Error> {
+    render_with_error(scene, settings, opts).map(|r| (r.image, r.stats))
+}
+
+/// Renders `scene` in `opts.passes` passes — or, with `opts.target_error`, in passes
+/// until the estimated relative RMSE is at most the target (at most
+/// [`MAX_TARGET_PASSES`], or until `opts.time_limit`) — each a forward pass of
+/// `settings.count()` photons per light with its own seed and a backward pass, and
+/// averages them (progressive photon mapping, Knaus & Zwicker 2011: the gathers' radius
+/// shrinks as `r_i² = r_1²·i^(α−1)`). The stopping test reads only deterministic
+/// numbers, so the same target gives the same bits on any thread count.
+pub fn render_with_error(
+    scene: &DesktopScene,
+    settings: &PhotonSettings,
+    opts: &RenderOptions,
+) -> Result<Rendered, Error> {
+    let t0 = Instant::now();
     let cam = scene.camera();
     let (w, h) = (cam.width(), cam.height());
     let threads = opts.threads.max(1);
-    let passes = opts.passes.max(1);
+    let passes = match opts.target_error {
+        Some(_) => MAX_TARGET_PASSES,
+        None => opts.passes.max(1),
+    };
     let mut stats = RenderStats {
         width: w,
         height: h,
         threads,
-        passes,
         ..RenderStats::default()
     };
-    let mut sum = Image::new(w, h);
-    let progress = Progress::new(opts.progress, passes);
-    // Progressive passes gather with a fixed radius (a k-nearest radius would not
-    // shrink with the passes, and the average would keep its bias).
-    let settings = &settings.with_fixed_radius(settings.fixed_radius() || passes > 1);
+    let progress = Progress::new(
+        opts.progress,
+        if opts.target_error.is_some() {
+            1
+        } else {
+            passes
+        },
+    );
+    // Without splats, progressive passes gather with a fixed radius (a k-nearest
+    // radius would not shrink with the passes, and the average would keep its bias);
+    // with them the gather is bounded by the shrinking pixel footprint.
+    let fixed = settings.fixed_radius() || (passes > 1 && !settings.camera_splats());
+    let settings = &settings.with_fixed_radius(fixed);
     let mut photons = PhotonBuffer::for_budget(scene, settings)?;
-    let mut image = Image::new(w, h);
+    let mut sum = Passes::new(w as usize, w as usize * h as usize);
     for pass in 0..passes {
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
         let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
@@ -372,47 +331,66 @@ pub fn render(
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
         let splats = settings.camera_splats().then(|| photons.splats());
         progress.phase(pass, "rows", h as usize);
-        backward_pass(
+        let frame = backward_pass(
             scene,
             &store,
             settings,
             (splats, shrink),
             opts,
-            &mut image,
             &progress,
             &mut stats,
         )?;
-        for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
-            *s += *p;
+        sum.add(&frame);
+        stats.passes = pass + 1;
+        if let Some(target) = opts.target_error {
+            let estimate = sum.tally().rel_rmse().unwrap_or(0.0);
+            stats.error.target = Some(target);
+            stats.error.reached = Some(estimate <= target as f64);
+            if estimate <= target as f64 {
+                break;
+            }
+            if opts
+                .time_limit
+                .is_some_and(|s| t0.elapsed().as_secs_f64() >= s)
+            {
+                stats.error.time_limited = true;
+                break;
+            }
         }
     }
     progress.finish();
-    if passes > 1 {
-        let inv = 1.0 / passes as f32;
-        for p in &mut sum.pixels {
-            *p = *p * inv;
-        }
-    }
-    Ok((sum, stats))
+    let (target, reached, limited) = (
+        stats.error.target,
+        stats.error.reached,
+        stats.error.time_limited,
+    );
+    stats.error = ErrorEstimate {
+        target,
+        reached,
+        time_limited: limited,
+        ..ErrorEstimate::from_tally(&sum.tally())
+    };
+    let (image, error) = sum.images(w, h);
+    Ok(Rendered {
+        image,
+        error,
+        stats,
+    })
 }
 
-/// The backward pass against one caustic store, into `image`, on `opts.threads`
-/// threads, adding its time, its gather time and its rays to `stats`.
-///
-/// With `splats` (the camera splats of the forward pass, and the pass's radius shrink
-/// factor) the store gathers only behind glass and mirrors, and the splats are added to
-/// the image, in emission order, after its rows.
-#[allow(clippy::too_many_arguments)]
+/// The backward pass against one caustic store on `opts.threads` threads: a frame of
+/// pixel estimates, the splats (the caustics seen directly, with the pass's radius
+/// shrink factor) added in emission order after its rows. Adds its time, its gather
+/// time and its rays to `stats`.
 fn backward_pass<S: CausticStore + Sync>(
     scene: &DesktopScene,
     store: &S,
     settings: &PhotonSettings,
     (splats, shrink): (Option<&[Splat]>, f32),
     opts: &RenderOptions,
-    image: &mut Image,
     progress: &Progress,
     stats: &mut RenderStats,
-) -> Result<(), Error> {
+) -> Result<vec::Vec<PixelEstimate>, Error> {
     let timed = Timed {
         inner: store,
         nanos: AtomicU64::new(0),
@@ -427,25 +405,35 @@ fn backward_pass<S: CausticStore + Sync>(
     if let Some(splats) = splats {
         renderer = renderer.with_splats(splats);
     }
+    let cam = scene.camera();
+    let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
     let t = Instant::now();
-    stats.rays += render_rows(&renderer, image, opts.threads.max(1), progress);
+    stats.rays += render_rows(
+        &renderer,
+        &mut frame,
+        cam.width() as usize,
+        opts.threads.max(1),
+        progress,
+    );
     if let Some(splats) = splats {
-        add_to_frame(splats, &mut image.pixels);
+        add_to_frame(splats, &mut frame);
+        stats.photons_splatted += splats.len() as u64;
     }
     stats.render_ms += ms(t.elapsed());
     stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
-    Ok(())
+    Ok(frame)
 }
 
-/// Renders all rows of `image` on `threads` threads, each taking the next free row.
+/// Renders all rows of `frame` (`width` pixels each) on `threads` threads, each taking
+/// the next free row.
 pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const D: usize>(
     renderer: &Renderer<'_, S, O, L, D>,
-    image: &mut Image,
+    frame: &mut [PixelEstimate],
+    width: usize,
     threads: usize,
     progress: &Progress,
 ) -> RayCount {
-    let width = image.width as usize;
-    let rows = Mutex::new(image.pixels.chunks_mut(width).enumerate());
+    let rows = Mutex::new(frame.chunks_mut(width.max(1)).enumerate());
     let total = Mutex::new(RayCount::default());
     std::thread::scope(|s| {
         for _ in 0..threads {
@@ -454,7 +442,7 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
                 loop {
                     let next = rows.lock().map(|mut r| r.next()).unwrap_or(None);
                     let Some((y, row)) = next else { break };
-                    mine += renderer.row(y as u32, row);
+                    mine += renderer.row_estimates(y as u32, row);
                     progress.tick();
                 }
                 if let Ok(mut t) = total.lock() {
@@ -466,71 +454,19 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
     total.into_inner().unwrap_or_default()
 }
 
-/// Progress on stderr (indicatif): one bar per phase of a pass — `photons` (chunks
-/// traced), `balance` (subtrees balanced), `rows` (rows rendered) — with the pass, the
-/// phase's name, the steps done and an ETA. Hidden unless enabled and stderr is a
-/// terminal. Workers tick it from any thread.
-#[derive(Debug)]
-pub struct Progress {
-    bar: indicatif::ProgressBar,
-    passes: u32,
-}
-
-impl Progress {
-    /// A bar over `passes` passes; draws nothing unless `enabled` and stderr is a
-    /// terminal.
-    pub fn new(enabled: bool, passes: u32) -> Self {
-        let bar = if enabled && std::io::stderr().is_terminal() {
-            indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::stderr())
-        } else {
-            indicatif::ProgressBar::hidden()
-        };
-        let template = "{prefix:>16} [{bar:30}] {pos}/{len} {elapsed:>4} ETA {eta}";
-        if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
-            bar.set_style(style.progress_chars("#>-"));
-        }
-        Self { bar, passes }
-    }
-
-    /// Starts phase `name` of pass `pass` (from 0) over `steps` steps.
-    pub fn phase(&self, pass: u32, name: &str, steps: usize) {
-        let prefix = if self.passes > 1 {
-            std::format!("pass {}/{} {name}", pass + 1, self.passes)
-        } else {
-            name.into()
-        };
-        self.bar.reset();
-        self.bar.set_prefix(prefix);
-        self.bar.set_length(steps as u64);
-    }
-
-    /// The current phase has `steps` steps after all (once they are known).
-    pub fn set_steps(&self, steps: usize) {
-        self.bar.set_length(steps as u64);
-    }
-
-    /// One step done.
-    pub fn tick(&self) {
-        self.bar.inc(1);
-    }
-
-    /// Clears the bar.
-    pub fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
-}
-
 /// Renders `scene` with Arvo's illumination maps (texels of side `texel_size` scene
 /// units) as the caustic store instead of the kd-tree: one forward pass into a photon
 /// array (timed as `emit_ms`), splatted into maps sized by the layout (timed as
 /// `balance_ms`, the store's build), then the backward pass. One pass only: the maps
 /// have no radius to shrink. Also returns what the map build did.
+/// With splats (the default) the maps serve only the diffuse points seen through glass
+/// or in mirrors, like the kd-tree.
 pub fn render_illumination(
     scene: &DesktopScene,
     settings: &PhotonSettings,
     opts: &RenderOptions,
     texel_size: f32,
-) -> Result<(Image, RenderStats, photon::MapStats), Error> {
+) -> Result<(Rendered, photon::MapStats), Error> {
     if opts.passes > 1 {
         return Err(Error::Unsupported {
             what: "progressive passes with illumination maps",
@@ -566,19 +502,27 @@ pub fn render_illumination(
     stats.balance_ms += ms(t.elapsed());
     progress.tick();
     progress.phase(0, "rows", h as usize);
-    let mut image = Image::new(w, h);
     let splats = settings.camera_splats().then_some(&splats[..]);
-    stats.photons_splatted = splats.map_or(0, |s| s.len() as u64);
-    backward_pass(
+    let frame = backward_pass(
         scene,
         &maps,
         settings,
         (splats, 1.0),
         opts,
-        &mut image,
         &progress,
         &mut stats,
     )?;
     progress.finish();
-    Ok((image, stats, map_stats))
+    let mut sum = Passes::new(w as usize, frame.len());
+    sum.add(&frame);
+    stats.error = ErrorEstimate::from_tally(&sum.tally());
+    let (image, error) = sum.images(w, h);
+    Ok((
+        Rendered {
+            image,
+            error,
+            stats,
+        },
+        map_stats,
+    ))
 }

@@ -213,8 +213,18 @@ mod tests {
         assert!(b
             .intersect(&ray([-5.0, 3.0, 0.0], [1.0, 0.0, 0.0]), f32::INFINITY)
             .is_none());
-        let h = b.intersect(&ray([-5.0, 2.0, 0.0], [1.0, 0.0, 0.0]), f32::INFINITY);
-        assert!(h.is_none_or(|h| h.t.is_finite() && h.point.is_finite()));
+        // The box is closed: a ray lying in the plane of the +y face (y = 2) touches it
+        // along that face, entering at the edge x = −1 (no NaN from 0·∞ on the y slab).
+        let h = b
+            .intersect(&ray([-5.0, 2.0, 0.0], [1.0, 0.0, 0.0]), f32::INFINITY)
+            .unwrap();
+        assert_eq!((h.t, h.normal), (4.0, -UnitVec3::X));
+        assert_eq!(h.point, Vec3::new(-1.0, 2.0, 0.0));
+        // Just outside that plane: a miss.
+        let above = f32::from_bits(2.0f32.to_bits() + 1);
+        assert!(b
+            .intersect(&ray([-5.0, above, 0.0], [1.0, 0.0, 0.0]), f32::INFINITY)
+            .is_none());
         // Through an edge diagonal.
         let h = b
             .intersect(&ray([-2.0, -3.0, 0.0], [1.0, 1.0, 0.0]), f32::INFINITY)

@@ -7,11 +7,13 @@
 //! (pbrt-v4's `OffsetRayOrigin`). There is no global epsilon: the offset scales with
 //! the magnitude of the coordinates involved, so a scene behaves the same at every size.
 
+mod chart;
 mod cuboid;
 mod cylinder;
 mod plane;
 mod sphere;
 
+pub(crate) use chart::SurfacePoint;
 pub use cuboid::Cuboid;
 pub use cylinder::Cylinder;
 pub use plane::Plane;

@@ -46,8 +46,10 @@
 //!   coordinates (angle × radius, area `Δθ·∫ w(ρ)·ρ dρ`).
 //!
 //! Only objects that store photons (a diffuse part) and received at least one photon
-//! get texels. A point is matched to the object whose surface is nearest (within
-//! `1e-4·max(1, |x|∞)`), the chart of a box face or cylinder cap by the normal.
+//! get texels. A photon carries the object it landed on ([`Photon::surface`]); a point
+//! without (a lookup from the eye pass, a photon made by hand) is matched to the object
+//! whose surface is nearest (within `1e-4·max(1, |x|∞)`), the chart of a box face or
+//! cylinder cap by the normal.
 //!
 //! # The classic model
 //! The paper's eq. 8 needs each photon's direction `l`. A texel keeps no direction, so
@@ -67,10 +69,10 @@ use core::f32::consts::PI;
 
 use heapless::Vec as FixedVec;
 
-use self::chart::{bounded_grids, distance, locate, pair, Grid, Located, Profile};
+use self::chart::{bounded_grids, pair, Grid, Profile};
 use super::{for_each_photon, CausticStore, ForwardStats, Photon, PhotonSettings};
 use crate::error::{positive, Error};
-use crate::geometry::Shape;
+use crate::geometry::{Shape, SurfacePoint};
 use crate::material::Classic;
 use crate::math::{max_abs, Rgb, UnitVec3, Vec3};
 use crate::scene::Scene;
@@ -369,7 +371,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         let mut dropped = Rgb::ZERO;
         let (mut n_in, mut n_out) = (0u64, 0u64);
         let unit = replay(&mut |p: &Photon| {
-            if self.splat(p.position(), p.direction(), p.power()) {
+            if self.splat(p) {
                 splatted += p.power();
                 n_in += 1;
             } else {
@@ -416,7 +418,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
     /// Layout pass: counts a front-side photon on its object and widens a plane's
     /// rectangle to it (a photon whose `(u, v)` overflows is left to be dropped).
     fn survey(&mut self, p: &Photon) {
-        let Some((k, at)) = self.find(p.position(), None) else {
+        let Some((k, at)) = self.landing(p) else {
             return;
         };
         if !(at.normal.dot(p.direction().get()) < 0.0) {
@@ -561,7 +563,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         for _round in 0..2 {
             let mut hist = [[[0u32; TRIM_BINS]; 2]; 2];
             replay(&mut |p: &Photon| {
-                if let Some((j, at)) = self.find(p.position(), None) {
+                if let Some((j, at)) = self.landing(p) {
                     if j == k && at.normal.dot(p.direction().get()) < 0.0 {
                         for a in 0..2 {
                             let x = [at.u, at.v][a];
@@ -613,27 +615,40 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// The mapped object (slot) nearest to `x` within tolerance, and where `x` lies on it.
     #[inline]
-    fn find(&self, x: Vec3, n: Option<UnitVec3>) -> Option<(usize, Located)> {
+    fn find(&self, x: Vec3, n: Option<UnitVec3>) -> Option<(usize, SurfacePoint)> {
         let tol = 1e-4 * max_abs(x).max(1.0);
         let mut best: Option<(usize, f32)> = None;
         for (k, m) in self.objects.iter().enumerate() {
-            let d = distance(&m.shape, x);
+            let d = m.shape.surface_distance(x);
             if d <= tol && best.is_none_or(|(_, bd)| d < bd) {
                 best = Some((k, d));
             }
         }
         let (k, _) = best?;
-        Some((k, locate(&self.objects[k].shape, x, n)))
+        Some((k, self.objects[k].shape.locate(x, n)))
     }
 
-    /// Splats `power` (any unit) arriving at `x` along `dir` into the four texels
-    /// around it: first between the two texel rows around it, then along each row.
-    /// `false` (nothing splatted) when it arrived from behind, or lies on no chart.
-    fn splat(&mut self, x: Vec3, dir: UnitVec3, power: Rgb) -> bool {
-        let Some((k, at)) = self.find(x, None) else {
+    /// The slot of the object photon `p` landed on, and where on it: the object the
+    /// forward pass marked it with ([`Photon::surface`]), else (a photon made
+    /// elsewhere) the mapped object nearest to its position.
+    #[inline]
+    fn landing(&self, p: &Photon) -> Option<(usize, SurfacePoint)> {
+        let Some(object) = p.surface() else {
+            return self.find(p.position(), None);
+        };
+        let k = self.objects.iter().position(|m| m.object == object)?;
+        Some((k, self.objects[k].shape.locate(p.position(), None)))
+    }
+
+    /// Splats photon `p`'s power (any unit) into the four texels around it: first
+    /// between the two texel rows around it, then along each row. `false` (nothing
+    /// splatted) when it arrived from behind, or lies on no chart.
+    fn splat(&mut self, p: &Photon) -> bool {
+        let Some((k, at)) = self.landing(p) else {
             return false;
         };
-        if !(at.normal.dot(dir.get()) < 0.0) {
+        let power = p.power();
+        if !(at.normal.dot(p.direction().get()) < 0.0) {
             return false; // arrived from behind the surface
         }
         let m = &self.objects[k];

@@ -372,7 +372,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 landing.hit.point,
                 landing.dir,
                 landing.power * (1.0 / self.unit),
-            ),
+            )
+            .on_surface(landing.object),
             splat,
         })
     }

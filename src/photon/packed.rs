@@ -6,7 +6,7 @@
 //! | 4 | power | shared-exponent RGB (Ward's RGBE), relative to the map's power unit |
 //! | 2 | direction of travel | octahedral map, 8 bits per coordinate (Cigolle et al. 2014) |
 //! | 1 | flags | bits 0–1: the kd-tree split axis; bit 7: scratch for balancing |
-//! | 1 | padding | |
+//! | 1 | surface | 1 + the index of the scene object it landed on; 0: unknown |
 //!
 //! The power is stored relative to a per-map unit (the nominal photon power), so the
 //! common photon of exactly nominal power is encoded without rounding.
@@ -21,7 +21,7 @@ pub struct Photon {
     rgbe: [u8; 4],
     dir: [u8; 2],
     pub(crate) flags: u8,
-    _pad: u8,
+    surface: u8,
 }
 
 const _: () = assert!(core::mem::size_of::<Photon>() == 20);
@@ -37,8 +37,26 @@ impl Photon {
             rgbe: encode_rgbe(power),
             dir: encode_octahedral(dir),
             flags: 0,
-            _pad: 0,
+            surface: 0,
         }
+    }
+
+    /// The same photon, marked as landed on scene object `object` (an index of 255 or
+    /// more is left unknown): the illumination maps then need not find its surface
+    /// again from its position.
+    pub fn on_surface(mut self, object: usize) -> Self {
+        self.surface = if object < u8::MAX as usize {
+            object as u8 + 1
+        } else {
+            0
+        };
+        self
+    }
+
+    /// The scene object it landed on, when known (see [`on_surface`](Self::on_surface)).
+    #[inline]
+    pub fn surface(&self) -> Option<usize> {
+        (self.surface > 0).then(|| self.surface as usize - 1)
     }
 
     /// An all-zero photon (const, for static arrays).
@@ -48,7 +66,7 @@ impl Photon {
             rgbe: [0; 4],
             dir: [0; 2],
             flags: 0,
-            _pad: 0,
+            surface: 0,
         }
     }
 

@@ -45,9 +45,8 @@
 //!   noise, which an image that must match a reference to 1e-3 cannot afford; the
 //!   fixed threshold biases by a bounded, measured amount (see [`DEFAULT_CUTOFF`]).
 //! - **ray budget** ([`Renderer::with_ray_budget`], default [`DEFAULT_RAY_BUDGET`]):
-//!   at most that many rays (eye and shadow) per camera ray, so a pixel spends at most
-//!   its samples (one, `n²`, or for [`Sampling::Adaptive`] at most `21n² + 4`) times
-//!   that. An eye ray is traced only when
+//!   at most that many rays (eye and shadow) per camera ray, and a pixel at most
+//!   [`Sampling::max_rays_per_pixel`] of them. An eye ray is traced only when
 //!   the rays already spent plus it and the shadow rays it may need (one per lit light)
 //!   stay within the budget; once one does not fit, every pending branch is dropped.
 //!   At each fork the heavier branch (larger channel sum) is followed first and the
@@ -70,7 +69,7 @@ mod pixels;
 
 use crate::scene::Scene;
 pub use estimate::{ErrorTally, PixelEstimate};
-pub use pixels::{Sampling, CONTRAST, REFINE, REFINE_TOLERANCE};
+pub use pixels::{Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -179,7 +178,7 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     /// Branches whose weight's largest channel is below this are not traced.
     cutoff: f32,
     /// Most rays (eye and shadow) per pixel.
-    ray_budget: u32,
+    pub(super) ray_budget: u32,
     /// Rays one eye ray may cost: itself and one shadow ray per lit light.
     rays_per_hit: u32,
 }
@@ -217,7 +216,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// channel below `cutoff ∈ [0, 1]` is not traced. `0` traces every non-black branch.
     /// Default [`DEFAULT_CUTOFF`]; see the [module documentation](self).
     pub fn with_cutoff(mut self, cutoff: f32) -> Result<Self, Error> {
-        self.cutoff = crate::error::in_range(cutoff, 0.0, 1.0, "image.ray_cutoff")?;
+        self.cutoff = crate::error::in_range(cutoff, 0.0, 1.0, "ray cutoff")?;
         Ok(self)
     }
 

@@ -36,6 +36,25 @@ pub const REFINE: u32 = 4;
 /// pixel's brightness (the brighter of its value and its brightest corner).
 pub const REFINE_TOLERANCE: f32 = 0.01;
 
+/// A pixel's further refinement stops before it would spend more than this many times
+/// the ray budget of one camera ray: a pixel costs at most its corners, its first grid
+/// and this many budgets.
+pub const REFINE_RAYS: u32 = 16;
+
+impl Sampling {
+    /// The most rays a pixel can cost, with `budget` rays per camera ray: one camera
+    /// ray's worth per sample of its grid and corners, plus for the adaptive scheme's
+    /// further refinement [`REFINE_RAYS`] budgets.
+    pub fn max_rays_per_pixel(&self, budget: u32) -> u64 {
+        let b = budget as u64;
+        match *self {
+            Sampling::Centre => b,
+            Sampling::Grid(n) => n as u64 * n as u64 * b,
+            Sampling::Adaptive(n) => (4 + n as u64 * n as u64 + REFINE_RAYS as u64) * b,
+        }
+    }
+}
+
 impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     Renderer<'_, S, O, L, DEPTH>
 {
@@ -74,18 +93,26 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// Pixel `(x, y)` on an `n × n` grid, then `2n × 2n` and `4n × 4n` while the
     /// grid's error estimate exceeds [`REFINE_TOLERANCE`] of the brighter of the
-    /// pixel's value and `bright` (a focus seen through glass needs hundreds of rays).
+    /// pixel's value and `bright` (a focus seen through glass needs hundreds of rays),
+    /// and while the next grid — four times the rays of the last — keeps the pixel
+    /// within [`REFINE_RAYS`] times the ray budget of one camera ray.
     fn refine(&self, x: u32, y: u32, n: u32, bright: f32, count: &mut RayCount) -> PixelEstimate {
+        let start = count.eye + count.shadow;
+        let cap = REFINE_RAYS as u64 * self.ray_budget as u64;
         let mut p = self.grid(x, y, n, count);
+        let mut last = count.eye + count.shadow - start;
         let mut m = n;
         while m < 4 * n && m <= 32 {
             let e = p.sampling2.luminance();
             let scale = crate::math::max(p.radiance.luminance(), bright) * REFINE_TOLERANCE;
-            if !(e > scale * scale) {
+            let spent = count.eye + count.shadow - start;
+            if !(e > scale * scale) || spent + 4 * last > cap {
                 break;
             }
             m *= 2;
+            let before = count.eye + count.shadow;
             p = self.grid(x, y, m, count);
+            last = count.eye + count.shadow - before;
         }
         p
     }

@@ -7,7 +7,10 @@ use std::time::Instant;
 use caustic::desktop::cli::RenderArgs;
 use caustic::desktop::image::{check_writable, Format, Image};
 use caustic::desktop::run::render_illumination;
-use caustic::desktop::{load_scene, render, LoadedScene, RenderStats, SceneError, StoreChoice};
+use caustic::desktop::{
+    load_scene, render_with_error, ErrorEstimate, LoadedScene, RenderStats, Rendered, SceneError,
+    StoreChoice,
+};
 use caustic::photon::MapStats;
 use caustic::raster::ToneMap;
 use serde::Serialize;
@@ -61,16 +64,42 @@ pub fn run(args: &RenderArgs) -> Result<(), Failure> {
     let settings = args.photons.finish(loaded.photons);
     let opts = args.options(&loaded);
     let parse_ms = ms(t0);
-    let (image, stats, maps) = match loaded.caustic_store {
-        StoreChoice::KdTree => render(&loaded.scene, &settings, &opts).map(|(i, s)| (i, s, None)),
+    let (rendered, maps) = match loaded.caustic_store {
+        StoreChoice::KdTree => {
+            render_with_error(&loaded.scene, &settings, &opts).map(|r| (r, None))
+        }
         StoreChoice::IlluminationMap { texel_size: t } => {
-            render_illumination(&loaded.scene, &settings, &opts, t)
-                .map(|(i, s, m)| (i, s, Some((t, m))))
+            render_illumination(&loaded.scene, &settings, &opts, t).map(|(r, m)| (r, Some((t, m))))
         }
     }
     .map_err(|e| bad_input(e.to_string()))?;
+    let Rendered {
+        image,
+        error,
+        stats,
+    } = rendered;
     let t_write = Instant::now();
     write(&image, &outputs, &tone)?;
+    if let Some(path) = &args.error_map {
+        error.write(path, Format::Pfm, &tone).map_err(|e| Failure {
+            code: 1,
+            message: format!("{}: {e}", path.display()),
+        })?;
+    }
+    if let Some(target) = stats.error.target {
+        let reached = stats.error.rel_rmse.unwrap_or(0.0);
+        let why = if stats.error.reached == Some(true) {
+            "reached"
+        } else if stats.error.time_limited {
+            "time limit"
+        } else {
+            "pass limit"
+        };
+        eprintln!(
+            "target error {target}: estimated relative RMSE {reached:.4} after {} passes ({why})",
+            stats.passes
+        );
+    }
     if args.stats {
         let times = Times {
             parse: parse_ms,
@@ -115,6 +144,7 @@ struct Stats {
     store: &'static str,
     #[serde(skip_serializing_if = "Option::is_none")]
     illumination: Option<Maps>,
+    error_estimate: ErrorEstimate,
 }
 
 /// Milliseconds per phase (`gather_cpu` summed over threads).
@@ -133,12 +163,16 @@ struct Times {
 struct Rays {
     eye: u64,
     shadow: u64,
+    /// Pixels whose corners disagreed and were supersampled.
+    refined_pixels: u64,
 }
 
 #[derive(Serialize)]
 struct Photons {
     emitted: u64,
     stored: u64,
+    /// Photons the camera sees directly, light-traced into their pixels.
+    splatted: u64,
 }
 
 /// What the illumination maps held.
@@ -149,6 +183,14 @@ struct Maps {
     bytes: usize,
     objects: usize,
     dropped_photons: u64,
+    /// The most texels the maps may hold.
+    texel_budget: usize,
+    /// Texels the layout would have needed at the asked texel size.
+    requested_texels: f64,
+    /// Objects whose texels were made coarser to fit the budget.
+    coarsened_objects: usize,
+    /// The coarsest texel side chosen, scene units.
+    largest_texel: f32,
 }
 
 impl Stats {
@@ -162,10 +204,12 @@ impl Stats {
             rays: Rays {
                 eye: s.rays.eye,
                 shadow: s.rays.shadow,
+                refined_pixels: s.rays.refined,
             },
             photons: Photons {
                 emitted: s.photons_emitted,
                 stored: s.photons_stored,
+                splatted: s.photons_splatted,
             },
             store: if maps.is_some() { "illum" } else { "kd" },
             illumination: maps.map(|(t, m)| Maps {
@@ -174,7 +218,12 @@ impl Stats {
                 bytes: m.texels * std::mem::size_of::<caustic::math::Rgb>(),
                 objects: m.mapped_objects,
                 dropped_photons: m.dropped_photons,
+                texel_budget: m.texel_budget,
+                requested_texels: m.requested_texels,
+                coarsened_objects: m.coarsened_objects,
+                largest_texel: m.largest_texel,
             }),
+            error_estimate: s.error,
         }
     }
 }

@@ -1,0 +1,215 @@
+//! The forward pass on the desktop: the photon array on the heap, traced in chunks
+//! on every thread and balanced in parallel, bit-identical to the core's
+//! [`photon::shoot_with_splats`] and [`balance`] whatever the thread count.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+use std::vec;
+
+use super::progress::Progress;
+use super::run::{ms, RenderStats};
+use super::MAX_PHOTONS;
+use crate::photon::{
+    self, balance, photons_needed, Emitter, KdTree, Landed, Photon, PhotonSettings, Splat,
+};
+use crate::scene::Scene;
+use crate::Error;
+
+/// The photon array of the forward pass, on the heap: allocated once for a budget and
+/// refilled in place by every progressive pass (fixed memory, Knaus & Zwicker 2011).
+#[derive(Debug)]
+pub struct PhotonBuffer {
+    photons: vec::Vec<Photon>,
+    len: usize,
+    unit: f32,
+    splats: vec::Vec<Splat>,
+}
+
+/// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
+/// [`MAX_PHOTONS`].
+pub(super) fn desktop_budget<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+) -> Result<usize, Error> {
+    let needed = photons_needed(scene, settings);
+    if needed > MAX_PHOTONS {
+        return Err(Error::Capacity {
+            what: "photons (count × lights)",
+            requested: needed,
+            capacity: MAX_PHOTONS,
+        });
+    }
+    Ok(needed)
+}
+
+/// Balances the kd-tree on `threads` threads: the top levels on this one, then the
+/// subtrees below them — disjoint ranges of the array — on all, then the permutation
+/// into heap order. The same array as [`balance`], bit for bit.
+fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress: &Progress) {
+    // Below this a thread costs more than it saves.
+    const SERIAL: usize = 1 << 15;
+    if threads <= 1 || photons.len() < SERIAL {
+        progress.phase(pass, "balance", 1);
+        balance(photons);
+        progress.tick();
+        return;
+    }
+    let n = photons.len();
+    let mut subtrees = vec::Vec::new();
+    // Four subtrees per thread, rounded up to a level: balances the load.
+    let levels = usize::BITS - (4 * threads - 1).leading_zeros();
+    progress.phase(pass, "balance", 0);
+    photon::balance_top(photons, levels, |t| subtrees.push(t));
+    subtrees.sort_by_key(|t| t.lo);
+    progress.set_steps(subtrees.len());
+    // Cut the array into the subtrees' disjoint slices.
+    let mut work = vec::Vec::with_capacity(subtrees.len());
+    let mut rest = &mut *photons;
+    let mut at = 0;
+    for t in subtrees {
+        let (_, tail) = rest.split_at_mut(t.lo - at);
+        let (slice, tail) = tail.split_at_mut(t.hi - t.lo);
+        work.push((slice, t));
+        rest = tail;
+        at = t.hi;
+    }
+    let work = Mutex::new(work);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
+                let Some((slice, t)) = next else { break };
+                photon::balance_subtree(slice, n, t);
+                progress.tick();
+            });
+        }
+    });
+    // Every subtree is partitioned, and the slices' borrow of `photons` is over.
+    drop(work);
+    photon::balance_finish(photons);
+}
+
+/// Photons traced per work item of the parallel forward pass. Fixed, so that the order
+/// of the stored photons — and so the tree and the image — does not depend on the
+/// number of threads.
+const CHUNK: u32 = 4096;
+
+impl PhotonBuffer {
+    /// Room for one forward pass of `settings` over `scene`; an error beyond
+    /// [`MAX_PHOTONS`].
+    pub fn for_budget<const O: usize, const L: usize>(
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+    ) -> Result<Self, Error> {
+        let needed = desktop_budget(scene, settings)?;
+        Ok(Self {
+            photons: vec![Photon::ZERO; needed],
+            len: 0,
+            unit: 0.0,
+            splats: vec::Vec::new(),
+        })
+    }
+
+    /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
+    /// adding the times and counts to `stats`. The photons are traced in chunks of
+    /// `CHUNK` and kept in emission order: the same array as the core's
+    /// [`photon::shoot`], whatever the thread count.
+    pub fn fill<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+        pass: u32,
+        threads: usize,
+        stats: &mut RenderStats,
+    ) -> Result<(), Error> {
+        let hidden = Progress::new(false, 1);
+        self.fill_with_progress(scene, settings, seed, pass, threads, stats, &hidden)
+    }
+
+    /// [`PhotonBuffer::fill`], showing its two phases (photons, balance) on `progress`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fill_with_progress<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+        pass: u32,
+        threads: usize,
+        stats: &mut RenderStats,
+        progress: &Progress,
+    ) -> Result<(), Error> {
+        let needed = photons_needed(scene, settings);
+        if needed > self.photons.len() {
+            return Err(Error::Capacity {
+                what: "photons (count × lights)",
+                requested: needed,
+                capacity: self.photons.len(),
+            });
+        }
+        let t = Instant::now();
+        let emitter = Emitter::new(scene, settings, seed, pass);
+        let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())
+            .flat_map(|l| {
+                let n = emitter.count(l);
+                (0..n)
+                    .step_by(CHUNK as usize)
+                    .map(move |s| (l, s, (s + CHUNK).min(n)))
+            })
+            .collect();
+        progress.phase(pass, "photons", items.len());
+        let results: vec::Vec<Mutex<vec::Vec<Landed>>> =
+            items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
+        let next = AtomicUsize::new(0);
+        std::thread::scope(|scope| {
+            for _ in 0..threads.clamp(1, items.len().max(1)) {
+                scope.spawn(|| loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(l, start, end)) = items.get(k) else {
+                        break;
+                    };
+                    let local: vec::Vec<Landed> =
+                        (start..end).filter_map(|i| emitter.land(l, i)).collect();
+                    if let Ok(mut slot) = results[k].lock() {
+                        *slot = local;
+                    }
+                    progress.tick();
+                });
+            }
+        });
+        let mut stored = 0;
+        self.splats.clear();
+        for r in results {
+            for x in r.into_inner().unwrap_or_default() {
+                self.photons[stored] = x.photon;
+                stored += 1;
+                self.splats.extend(x.splat);
+            }
+        }
+        stats.emit_ms += ms(t.elapsed());
+        let t = Instant::now();
+        balance_parallel(&mut self.photons[..stored], threads, pass, progress);
+        stats.balance_ms += ms(t.elapsed());
+        stats.photons_emitted += emitter.emitted();
+        stats.photons_stored += stored as u64;
+        self.len = stored;
+        self.unit = emitter.power_unit();
+        Ok(())
+    }
+
+    /// The balanced tree of the last pass.
+    pub fn tree(&self) -> KdTree<'_> {
+        KdTree::from_balanced(&self.photons[..self.len])
+    }
+
+    /// Power of one stored unit, W.
+    pub fn unit(&self) -> f32 {
+        self.unit
+    }
+
+    /// The camera splats of the last pass, in emission order.
+    pub fn splats(&self) -> &[Splat] {
+        &self.splats
+    }
+}

@@ -1,0 +1,62 @@
+//! What several integration tests share: reading the example scenes, a small
+//! deterministic generator, FNV-1a, and the generator of hostile scenes
+//! ([`hostile`]). Each test file takes it with `mod support;` and uses a part of it.
+#![allow(dead_code)]
+
+pub mod hostile;
+
+use caustic::sampling::mix64;
+
+/// The text of `scenes/<name>`.
+pub fn scene_text(name: &str) -> String {
+    let path = format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// The text of `tests/data/<name>`.
+pub fn data_text(name: &str) -> String {
+    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// FNV-1a (32-bit) of a byte stream, as the firmware prints it (`PASS fnv1a=0x…`).
+pub fn fnv1a(bytes: &[u8]) -> u32 {
+    bytes.iter().fold(0x811c_9dc5u32, |h, &b| {
+        (h ^ b as u32).wrapping_mul(0x0100_0193)
+    })
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): the core's finaliser
+/// [`caustic::sampling::mix64`] over a Weyl sequence. A tiny deterministic generator for
+/// the scene fuzzers.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        mix64(self.0)
+    }
+    /// Uniform in `[0, 1)` (24 bits).
+    pub fn f(&mut self) -> f32 {
+        (self.u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+    pub fn range(&mut self, a: f32, b: f32) -> f32 {
+        a + (b - a) * self.f()
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.u64() % n
+    }
+    pub fn chance(&mut self, p: f32) -> bool {
+        self.f() < p
+    }
+    pub fn v(&mut self, e: f32) -> caustic::math::Vec3 {
+        caustic::math::Vec3::new(self.range(-e, e), self.range(-e, e), self.range(-e, e))
+    }
+    pub fn rgb(&mut self, max: f32) -> caustic::math::Rgb {
+        caustic::math::Rgb::new(
+            self.range(0.0, max),
+            self.range(0.0, max),
+            self.range(0.0, max),
+        )
+    }
+}
