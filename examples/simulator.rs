@@ -1,7 +1,7 @@
 //! The desktop simulator: watch a device render on the desktop.
 //!
-//! Builds the scene in code exactly as the Cortex-M4 firmware does
-//! ([`caustic::demo::fig6`] with [`caustic::demo::device_settings`]: 2 048 photons,
+//! Builds the scene in code exactly as the device firmware does
+//! ([`caustic::demo::fig6`] with [`caustic::budget::FIG6`]: 2 048 photons,
 //! K = 32, path stack of 8, seed 0, [`ToneMap::default`], no dithering), renders it row
 //! by row through the library's `DrawTarget` adapter ([`DisplaySink`]) onto an
 //! `embedded-graphics-simulator` [`SimulatorDisplay`] of the device's 160×120 RGB565
@@ -58,26 +58,26 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use caustic::demo;
 use caustic::desktop::{self, MAX_DEPTH, MAX_GATHER, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::math::Rgb;
 use caustic::photon::{self, KdTree, Photon, PhotonSettings};
 use caustic::raster::{DisplaySink, Dither, ToneMap};
 use caustic::render::Renderer;
 use caustic::scene::Scene;
+use caustic::{budget, demo};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::{BinaryColor, PixelColor, Rgb565, Rgb888};
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay, Window};
 
 /// Gather capacity K of the device build.
-pub const DEVICE_GATHER: usize = demo::DEVICE_K as usize;
+pub const DEVICE_GATHER: usize = budget::FIG6.k;
 /// Path stack DEPTH of the device build.
-pub const DEVICE_DEPTH: usize = demo::DEVICE_MAX_DEPTH as usize;
+pub const DEVICE_DEPTH: usize = budget::FIG6.depth;
 /// Objects of the device build's scene type.
-pub const DEVICE_OBJECTS: usize = 2;
+pub const DEVICE_OBJECTS: usize = budget::FIG6_OBJECTS;
 /// Lights of the device build's scene type.
-pub const DEVICE_LIGHTS: usize = 1;
+pub const DEVICE_LIGHTS: usize = budget::FIG6_LIGHTS;
 
 /// The display's colour format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -255,7 +255,7 @@ where
     match &opts.scene {
         None => {
             let scene = demo::fig6::<DEVICE_OBJECTS, DEVICE_LIGHTS>(opts.width, opts.height)?;
-            let device = demo::device_settings()?;
+            let device = budget::FIG6.settings()?;
             let settings = with_count(&device, opts.photons)?;
             draw::<_, DEVICE_OBJECTS, DEVICE_LIGHTS, DEVICE_GATHER, DEVICE_DEPTH>(
                 &scene,

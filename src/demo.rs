@@ -2,7 +2,8 @@
 //!
 //! [`fig6`] is the paper's Fig. 6 scene (section 3.3) exactly as `scenes/fig6.json`
 //! describes it (a test checks that they agree), so a device, the desktop simulator and
-//! the desktop renderer draw the same thing.
+//! the desktop renderer draw the same thing. A device's capacities and photon budget
+//! for it are [`crate::budget::FIG6`].
 
 use crate::camera::Camera;
 use crate::error::Error;
@@ -10,17 +11,7 @@ use crate::geometry::Shape;
 use crate::light::PointLight;
 use crate::material::{Classic, Material};
 use crate::math::{Rgb, Vec3};
-use crate::photon::PhotonSettings;
 use crate::scene::Scene;
-
-/// Photons per light of the device build: 2 048 photons, 40 KiB of map.
-pub const DEVICE_PHOTONS: u32 = 2048;
-/// Photons per estimate on the device.
-pub const DEVICE_K: u32 = 32;
-/// Gather radius bound on the device, scene units (the cube's edge is 4).
-pub const DEVICE_MAX_RADIUS: f32 = 1.0;
-/// Specular interactions per path on the device.
-pub const DEVICE_MAX_DEPTH: u32 = 8;
 
 /// The paper's Fig. 6: a transparent green `classic` cube (ambient 0.3, diffuse 0.9,
 /// specular 0.2, reflectivity 0.2, transparency 0.7, ior 1.25), edge 4 at (2, 1, −1),
@@ -65,15 +56,4 @@ pub fn fig6<const O: usize, const L: usize>(width: u32, height: u32) -> Result<S
         cube,
     )?;
     Ok(scene)
-}
-
-/// The device's photon settings: [`DEVICE_PHOTONS`], [`DEVICE_K`],
-/// [`DEVICE_MAX_RADIUS`], [`DEVICE_MAX_DEPTH`].
-pub fn device_settings() -> Result<PhotonSettings, Error> {
-    PhotonSettings::new(
-        DEVICE_PHOTONS,
-        DEVICE_K,
-        DEVICE_MAX_RADIUS,
-        DEVICE_MAX_DEPTH,
-    )
 }

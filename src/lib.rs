@@ -54,6 +54,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod budget;
 pub mod camera;
 pub mod demo;
 mod error;

@@ -1,0 +1,200 @@
+//! caustic on a microcontroller: the paper's Fig. 6 at 160 × 120 under QEMU, one
+//! source for four instruction sets (Cortex-M4F `mps2-an386`, Cortex-M3 `mps2-an385`,
+//! Cortex-M33 `mps2-an505`, RV32IMAC `virt`); only the reset code and the semihosting
+//! trap differ (`arm.rs`, `riscv.rs`, `semihosting.rs`).
+//!
+//! Every capacity is `caustic::budget::FIG6`: the forward pass fills a
+//! `DeviceMap<{ FIG6.stored }>` that lives in a `static` (in `.bss`, not on the
+//! stack); the backward pass renders one row at a time into a 160-pixel buffer, and
+//! each row goes through `caustic::raster::DisplaySink` onto a
+//! `caustic::raster::Rgb565Stream` whose bytes (little-endian RGB565, row-major) are
+//! appended to a file on the host by semihosting. No frame buffer exists on the device.
+//!
+//! Output (semihosting stdout): the photon and ray counts, the stack's high-water mark,
+//! and `PASS fnv1a=0x…`, the FNV-1a of the RGB565 bytes. QEMU exits with 0 on success
+//! and 1 on any failure, panic or fault. The output path is the second word of the
+//! semihosting command line (`arg=caustic,arg=PATH`), else `fig6.rgb565`.
+//!
+//! `caustic_mark_*` are empty functions the run script's QEMU plugin recognises by
+//! address to count the instructions of each phase.
+
+#![no_std]
+#![no_main]
+
+mod semihosting;
+
+#[cfg(target_arch = "arm")]
+mod arm;
+#[cfg(target_arch = "arm")]
+use arm as platform;
+#[cfg(target_arch = "riscv32")]
+mod riscv;
+#[cfg(target_arch = "riscv32")]
+use riscv as platform;
+
+use core::cell::UnsafeCell;
+use core::sync::atomic::{AtomicBool, Ordering};
+
+use caustic::budget::{DeviceMap, FIG6, FIG6_LIGHTS, FIG6_OBJECTS};
+use caustic::demo;
+use caustic::math::Rgb;
+use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
+use caustic::render::Renderer;
+use semihosting::HostFile;
+
+/// The target this firmware was built for (set by build.rs).
+const TARGET: &str = env!("CAUSTIC_FIRMWARE_TARGET");
+/// Row length, pixels.
+const WIDTH: usize = FIG6.width as usize;
+
+type Map = DeviceMap<{ FIG6.stored }>;
+
+/// The photon map's storage: a `static`, so it is in `.bss`, counted by the linker,
+/// and never on the stack.
+struct MapCell(UnsafeCell<Map>);
+
+// SAFETY: the map is only reached through `take_map`, which hands out its one `&mut`
+// once (guarded by `MAP_TAKEN`); nothing else touches `MAP`.
+#[allow(unsafe_code)]
+unsafe impl Sync for MapCell {}
+
+static MAP: MapCell = MapCell(UnsafeCell::new(Map::new()));
+static MAP_TAKEN: AtomicBool = AtomicBool::new(false);
+
+/// The photon map, exclusively; `None` after the first call.
+fn take_map() -> Option<&'static mut Map> {
+    // A load and a store, not `swap`: Armv7-M has no atomic swap instruction issue
+    // here, but RV32 without the A extension would; the firmware is single-threaded.
+    if MAP_TAKEN.load(Ordering::Acquire) {
+        return None;
+    }
+    MAP_TAKEN.store(true, Ordering::Release);
+    // SAFETY: the flag above makes this the only reference ever created to `MAP`'s
+    // contents (one thread, no interrupts), and `MAP` is private to this module.
+    #[allow(unsafe_code)]
+    Some(unsafe { &mut *MAP.0.get() })
+}
+
+/// Bytes of stack ever used, and reserved: the painted words from `_stack_end` up
+/// that are still painted lie below the deepest point the stack reached.
+fn stack_high_water() -> (usize, usize) {
+    extern "C" {
+        static _stack_end: u32;
+        static _stack_start: u32;
+    }
+    let start = core::ptr::addr_of!(_stack_end) as usize;
+    let top = core::ptr::addr_of!(_stack_start) as usize;
+    let mut p = start;
+    while p < top {
+        // SAFETY: `_stack_end.._stack_start` is RAM reserved for the stack (linker
+        // script); reading an aligned word of it is always defined.
+        #[allow(unsafe_code)]
+        let v = unsafe { core::ptr::read_volatile(p as *const u32) };
+        if v != platform::STACK_PAINT {
+            break;
+        }
+        p += 4;
+    }
+    (top - p, top - start)
+}
+
+macro_rules! marker {
+    ($name:ident, $n:expr) => {
+        /// Phase marker for the instruction-count plugin: does nothing, is never inlined.
+        #[inline(never)]
+        #[no_mangle]
+        extern "C" fn $name() {
+            core::hint::black_box($n);
+        }
+    };
+}
+marker!(caustic_mark_photons_begin, 1u32);
+marker!(caustic_mark_photons_end, 2u32);
+marker!(caustic_mark_render_begin, 3u32);
+marker!(caustic_mark_render_end, 4u32);
+
+/// Stops with a failure. The core's `Error` is not formatted: its `Display` prints
+/// `f32` fields, and float formatting alone is about 16 KiB of flash. The host test
+/// (`tests/device.rs`) runs the same code and shows the error's text.
+fn fail(what: &str) -> ! {
+    hprintln!("FAIL {}", what);
+    semihosting::exit(false)
+}
+
+/// The whole run; called by the platform's reset code.
+pub fn run() -> ! {
+    hprintln!(
+        "caustic on {}: Fig. 6, {}x{}, seed {}",
+        TARGET,
+        FIG6.width,
+        FIG6.height,
+        FIG6.seed
+    );
+    let mut path_buf = [0u8; 256];
+    let path = semihosting::output_path(&mut path_buf, b"fig6.rgb565");
+
+    let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(FIG6.width, FIG6.height)
+        .unwrap_or_else(|_| fail("scene"));
+    let settings = FIG6.settings().unwrap_or_else(|_| fail("settings"));
+    let map = take_map().unwrap_or_else(|| fail("photon map taken twice"));
+
+    caustic_mark_photons_begin();
+    let forward = map.build(&scene, &settings, FIG6.seed);
+    caustic_mark_photons_end();
+    let forward = forward.unwrap_or_else(|_| fail("forward pass (more photons than FIG6.stored?)"));
+    hprintln!(
+        "photons: {} emitted, {} stored (capacity {})",
+        forward.emitted,
+        forward.stored,
+        FIG6.stored
+    );
+
+    let store = map
+        .store::<{ FIG6.k }>(&settings)
+        .unwrap_or_else(|_| fail("store"));
+    let renderer: Renderer<_, FIG6_OBJECTS, FIG6_LIGHTS, { FIG6.depth }> =
+        Renderer::new(&scene, &store, settings.max_depth()).unwrap_or_else(|_| fail("renderer"));
+    let mut file = HostFile::create(path).unwrap_or_else(|e| fail(e));
+    let mut stream =
+        Rgb565Stream::<_, WIDTH>::new(FIG6.width, FIG6.height, |b: &[u8]| file.write(b))
+            .unwrap_or_else(|_| fail("display"));
+    let mut row = [Rgb::ZERO; WIDTH];
+
+    caustic_mark_render_begin();
+    let rays = {
+        let mut sink = DisplaySink::new(&mut stream, ToneMap::default(), Dither::Off);
+        renderer.rows(&mut row, |y, pixels| sink.draw_row(y, pixels))
+    };
+    caustic_mark_render_end();
+    let rays = rays.unwrap_or_else(|_| fail("writing the image"));
+
+    let (pixels, hash, complete) = (stream.pixels(), stream.hash(), stream.is_complete());
+    let _ = stream.into_writer(); // gives `file` back
+    file.close().unwrap_or_else(|e| fail(e));
+    hprintln!("rays: {} eye, {} shadow", rays.eye, rays.shadow);
+    let (stack, reserved) = stack_high_water();
+    hprintln!(
+        "stack high-water: {} bytes (of {} reserved)",
+        stack,
+        reserved
+    );
+    if !complete {
+        fail("not every pixel was written");
+    }
+    hprintln!(
+        "PASS fnv1a=0x{:08x} pixels={} stack={}",
+        hash,
+        pixels,
+        stack
+    );
+    semihosting::exit(true)
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    match info.location() {
+        Some(l) => hprintln!("PANIC at {}:{}", l.file(), l.line()),
+        None => hprintln!("PANIC"),
+    }
+    semihosting::exit(false)
+}
