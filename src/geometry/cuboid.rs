@@ -2,7 +2,7 @@
 
 use super::{error_bound, BoundingSphere, Hit, Ray};
 use crate::error::{positive, Error};
-use crate::math::{finite_vec, max_abs, Mat3, UnitVec3, Vec3};
+use crate::math::{finite_vec, max_abs, sin_cos_turns, Mat3, UnitVec3, Vec3};
 
 /// A box of full edge lengths `size`, rotated about its centre by `rotation_deg`
 /// (degrees, applied about X, then Y, then Z: `R = Rz·Ry·Rx`).
@@ -31,9 +31,8 @@ impl Cuboid {
         for s in size.to_array() {
             positive(s, "box size")?;
         }
-        let r = finite_vec(rotation_deg, "box rotation_deg")? * (core::f32::consts::PI / 180.0);
-        let rotation =
-            Mat3::from_rotation_z(r.z) * Mat3::from_rotation_y(r.y) * Mat3::from_rotation_x(r.x);
+        let turns = finite_vec(rotation_deg, "box rotation_deg")? * (1.0 / 360.0);
+        let rotation = rotation_zyx(turns);
         let half = size * 0.5;
         let error = error_bound(max_abs(center) + half.length());
         let reject_r = half.length() * (1.0 + 1e-4) + error;
@@ -188,6 +187,19 @@ impl Cuboid {
     }
 }
 
+/// `R = Rz·Ry·Rx` for angles given in turns, with [`sin_cos_turns`]: single
+/// precision only (glam's rotations call `libm::sincosf`, whose `f64` kernels are
+/// 3 KiB of flash and soft-float on a device), and exact at quarter turns.
+fn rotation_zyx(turns: Vec3) -> Mat3 {
+    let (sx, cx) = sin_cos_turns(turns.x);
+    let (sy, cy) = sin_cos_turns(turns.y);
+    let (sz, cz) = sin_cos_turns(turns.z);
+    let rx = Mat3::from_cols(Vec3::X, Vec3::new(0.0, cx, sx), Vec3::new(0.0, -sx, cx));
+    let ry = Mat3::from_cols(Vec3::new(cy, 0.0, -sy), Vec3::Y, Vec3::new(sy, 0.0, cy));
+    let rz = Mat3::from_cols(Vec3::new(cz, sz, 0.0), Vec3::new(-sz, cz, 0.0), Vec3::Z);
+    rz * ry * rx
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,6 +294,24 @@ mod tests {
                     }
                     (None, Some(bt)) => panic!("{i},{j}: missed a box the march enters at {bt}"),
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn rotation_is_glams_to_a_few_ulps() {
+        for deg in [
+            Vec3::new(0.0, 30.0, 0.0),
+            Vec3::new(10.0, 20.0, 30.0),
+            Vec3::new(-45.0, 400.0, 90.0),
+        ] {
+            let r = deg * (core::f32::consts::PI / 180.0);
+            let glam = Mat3::from_rotation_z(r.z)
+                * Mat3::from_rotation_y(r.y)
+                * Mat3::from_rotation_x(r.x);
+            let ours = rotation_zyx(deg * (1.0 / 360.0));
+            for (a, b) in ours.to_cols_array().into_iter().zip(glam.to_cols_array()) {
+                assert!((a - b).abs() < 1e-6, "{deg}: {a} {b}");
             }
         }
     }

@@ -5,7 +5,8 @@
 //!
 //! Every capacity is `caustic::budget::FIG6`: the forward pass fills a
 //! `DeviceMap<{ FIG6.stored }>` that lives in a `static` (in `.bss`, not on the
-//! stack); the backward pass renders one row at a time into a 160-pixel buffer, and
+//! stack); the backward pass renders one row at a time into a 160-pixel buffer (also
+//! static: the stack holds only the path stack, the gather and the call frames), and
 //! each row goes through `caustic::raster::DisplaySink` onto a
 //! `caustic::raster::Rgb565Stream` whose bytes (little-endian RGB565, row-major) are
 //! appended to a file on the host by semihosting. No frame buffer exists on the device.
@@ -47,32 +48,40 @@ const TARGET: &str = env!("CAUSTIC_FIRMWARE_TARGET");
 /// Row length, pixels.
 const WIDTH: usize = FIG6.width as usize;
 
-type Map = DeviceMap<{ FIG6.stored }>;
+/// What the render keeps outside the stack: the photon map (in `.bss`, counted by
+/// the linker), the row of linear radiance, and the output path.
+struct Statics {
+    map: DeviceMap<{ FIG6.stored }>,
+    row: [Rgb; WIDTH],
+    path: [u8; 256],
+}
 
-/// The photon map's storage: a `static`, so it is in `.bss`, counted by the linker,
-/// and never on the stack.
-struct MapCell(UnsafeCell<Map>);
+struct StaticsCell(UnsafeCell<Statics>);
 
-// SAFETY: the map is only reached through `take_map`, which hands out its one `&mut`
-// once (guarded by `MAP_TAKEN`); nothing else touches `MAP`.
+// SAFETY: the contents are only reached through `take_statics`, which hands out their
+// one `&mut` once (guarded by `TAKEN`); nothing else touches `STATICS`.
 #[allow(unsafe_code)]
-unsafe impl Sync for MapCell {}
+unsafe impl Sync for StaticsCell {}
 
-static MAP: MapCell = MapCell(UnsafeCell::new(Map::new()));
-static MAP_TAKEN: AtomicBool = AtomicBool::new(false);
+static STATICS: StaticsCell = StaticsCell(UnsafeCell::new(Statics {
+    map: DeviceMap::new(),
+    row: [Rgb::ZERO; WIDTH],
+    path: [0; 256],
+}));
+static TAKEN: AtomicBool = AtomicBool::new(false);
 
-/// The photon map, exclusively; `None` after the first call.
-fn take_map() -> Option<&'static mut Map> {
-    // A load and a store, not `swap`: Armv7-M has no atomic swap instruction issue
-    // here, but RV32 without the A extension would; the firmware is single-threaded.
-    if MAP_TAKEN.load(Ordering::Acquire) {
+/// The statics, exclusively; `None` after the first call.
+fn take_statics() -> Option<&'static mut Statics> {
+    // A load and a store, not `swap`: the firmware is single-threaded, and RV32
+    // without the A extension has no atomic swap.
+    if TAKEN.load(Ordering::Acquire) {
         return None;
     }
-    MAP_TAKEN.store(true, Ordering::Release);
-    // SAFETY: the flag above makes this the only reference ever created to `MAP`'s
-    // contents (one thread, no interrupts), and `MAP` is private to this module.
+    TAKEN.store(true, Ordering::Release);
+    // SAFETY: the flag above makes this the only reference ever created to
+    // `STATICS`' contents (one thread, no interrupts), and it is private to this module.
     #[allow(unsafe_code)]
-    Some(unsafe { &mut *MAP.0.get() })
+    Some(unsafe { &mut *STATICS.0.get() })
 }
 
 /// Bytes of stack ever used, and reserved: the painted words from `_stack_end` up
@@ -130,13 +139,12 @@ pub fn run() -> ! {
         FIG6.height,
         FIG6.seed
     );
-    let mut path_buf = [0u8; 256];
-    let path = semihosting::output_path(&mut path_buf, b"fig6.rgb565");
+    let Statics { map, row, path } = take_statics().unwrap_or_else(|| fail("statics taken twice"));
+    let path = semihosting::output_path(path, b"fig6.rgb565");
 
     let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(FIG6.width, FIG6.height)
         .unwrap_or_else(|_| fail("scene"));
     let settings = FIG6.settings().unwrap_or_else(|_| fail("settings"));
-    let map = take_map().unwrap_or_else(|| fail("photon map taken twice"));
 
     caustic_mark_photons_begin();
     let forward = map.build(&scene, &settings, FIG6.seed);
@@ -158,12 +166,11 @@ pub fn run() -> ! {
     let mut stream =
         Rgb565Stream::<_, WIDTH>::new(FIG6.width, FIG6.height, |b: &[u8]| file.write(b))
             .unwrap_or_else(|_| fail("display"));
-    let mut row = [Rgb::ZERO; WIDTH];
 
     caustic_mark_render_begin();
     let rays = {
         let mut sink = DisplaySink::new(&mut stream, ToneMap::default(), Dither::Off);
-        renderer.rows(&mut row, |y, pixels| sink.draw_row(y, pixels))
+        renderer.rows(row, |y, pixels| sink.draw_row(y, pixels))
     };
     caustic_mark_render_end();
     let rays = rays.unwrap_or_else(|_| fail("writing the image"));
