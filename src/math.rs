@@ -162,7 +162,8 @@ impl UnitVec3 {
     #[inline]
     pub fn new(v: Vec3) -> Option<Self> {
         let len2 = v.length_squared();
-        if !(len2 > 0.0 && len2 < f32::INFINITY) {
+        // Two float comparisons; LLVM turns `< ∞` into a 16-instruction integer test.
+        if !(len2 > 0.0) || !(len2 <= f32::MAX) {
             return None;
         }
         Some(Self(v * (1.0 / sqrt(len2))))

@@ -109,15 +109,32 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
         self.objects.iter().any(|o| o.material.is_specular())
     }
 
-    /// The nearest hit along `ray` with `t < t_max`, and the index of the object hit.
+    /// The nearest hit along `ray` with `t < t_max`, and the index of the object hit
+    /// (on an exact tie, the lower index).
+    ///
+    /// Bounded shapes are tried before unbounded planes: a nearer hit found first
+    /// narrows `t_max`, and a plane hit beyond it is then dismissed after its distance,
+    /// before its point is built (a ray leaving a box towards the floor, the common
+    /// case of a glass object above a plane). Bounded shapes reject cheaply by their
+    /// bounding sphere whatever the order.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(Hit, usize)> {
         let mut best: Option<(Hit, usize)> = None;
         let mut limit = t_max;
-        for (i, o) in self.objects.iter().enumerate() {
-            if let Some(h) = o.shape.intersect(ray, limit) {
-                limit = h.t;
-                best = Some((h, i));
+        for bounded in [true, false] {
+            for (i, o) in self.objects.iter().enumerate() {
+                if o.shape.is_bounded() != bounded {
+                    continue;
+                }
+                // A later index must be strictly nearer; an earlier one wins a tie.
+                let reach = match best {
+                    Some((_, j)) if j > i => next_up(limit),
+                    _ => limit,
+                };
+                if let Some(h) = o.shape.intersect(ray, reach) {
+                    limit = h.t;
+                    best = Some((h, i));
+                }
             }
         }
         best
@@ -130,6 +147,16 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.objects.iter().any(|o| o.shape.blocks(ray, t_max))
+    }
+}
+
+/// The next `f32` above a positive `x` (`+∞` stays).
+#[inline]
+fn next_up(x: f32) -> f32 {
+    if x < f32::INFINITY {
+        f32::from_bits(x.to_bits() + 1)
+    } else {
+        x
     }
 }
 
@@ -166,6 +193,29 @@ mod tests {
         let r = Ray::new(Vec3::ZERO, UnitVec3::Z);
         let (h, i) = s.intersect(&r, f32::INFINITY).unwrap();
         assert_eq!((h.t, i), (4.0, 1));
+        // Planes are tried after bounded shapes, but the order of the scene decides ties
+        // and the nearest hit wins.
+        let mut t: Scene<3, 1> = Scene::new(cam);
+        t.add(Shape::plane(Vec3::new(0.0, 0.0, 4.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        t.add(Shape::sphere(Vec3::new(0.0, 0.0, 5.0), 1.0).unwrap(), m)
+            .unwrap();
+        t.add(Shape::plane(Vec3::new(0.0, 0.0, 3.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        assert_eq!(
+            t.intersect(&r, f32::INFINITY).map(|(h, i)| (h.t, i)),
+            Some((3.0, 2))
+        );
+        assert_eq!(t.intersect(&r, 3.5).map(|(h, i)| (h.t, i)), Some((3.0, 2)));
+        let mut tie: Scene<2, 1> = Scene::new(cam);
+        tie.add(Shape::plane(Vec3::new(0.0, 0.0, 4.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        tie.add(Shape::sphere(Vec3::new(0.0, 0.0, 5.0), 1.0).unwrap(), m)
+            .unwrap();
+        assert_eq!(
+            tie.intersect(&r, f32::INFINITY).map(|(h, i)| (h.t, i)),
+            Some((4.0, 0))
+        );
         assert!(s.occluded(&r, 4.5) && !s.occluded(&r, 3.5));
     }
 }

@@ -99,31 +99,17 @@ impl Cuboid {
     #[inline]
     fn slabs(&self, o: [f32; 3], d: [f32; 3]) -> Option<(f32, usize, f32, usize)> {
         let half = self.half.to_array();
-        let (mut t_near, mut t_far) = (f32::NEG_INFINITY, f32::INFINITY);
-        let (mut near_axis, mut far_axis) = (0usize, 0usize);
-        for i in 0..3 {
-            let (oi, di, hi) = (o[i], d[i], half[i]);
-            if di == 0.0 {
-                if oi < -hi || oi > hi {
-                    return None;
-                }
-                continue;
-            }
-            let inv = 1.0 / di;
-            let (mut ta, mut tb) = ((-hi - oi) * inv, (hi - oi) * inv);
-            if ta > tb {
-                core::mem::swap(&mut ta, &mut tb);
-            }
-            if ta > t_near {
-                t_near = ta;
-                near_axis = i;
-            }
-            if tb < t_far {
-                t_far = tb;
-                far_axis = i;
-            }
-        }
-        (t_near <= t_far).then_some((t_near, near_axis, t_far, far_axis))
+        let mut s = Slabs {
+            t_near: f32::NEG_INFINITY,
+            near_axis: 0,
+            t_far: f32::INFINITY,
+            far_axis: 0,
+        };
+        // Unrolled by hand: a loop over an index keeps its bounds checks on Armv7-M.
+        let inside = s.axis(0, o[0], d[0], half[0])
+            && s.axis(1, o[1], d[1], half[1])
+            && s.axis(2, o[2], d[2], half[2]);
+        (inside && s.t_near <= s.t_far).then_some((s.t_near, s.near_axis, s.t_far, s.far_axis))
     }
 
     /// The ray in the box's frame: origin and direction.
@@ -153,11 +139,10 @@ impl Cuboid {
             return None;
         }
         let half = self.half.to_array();
-        let mut local = [0.0f32; 3];
-        for i in 0..3 {
-            // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
-            local[i] = crate::math::clamp(o[i] + d[i] * t, -half[i], half[i]);
-        }
+        // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
+        let clamp = |i: usize| crate::math::clamp(o[i] + d[i] * t, -half[i], half[i]);
+        let mut local = [clamp(0), clamp(1), clamp(2)];
+        let axis = axis.min(2); // always: the index of a slab; lets the compiler drop checks
         local[axis] = sign * half[axis];
         let point = self.center + self.rotation * Vec3::from_array(local);
         let normal = self.normals[axis][(sign > 0.0) as usize];
@@ -184,6 +169,41 @@ impl Cuboid {
         };
         let t = if t_near > 0.0 { t_near } else { t_far };
         t > 0.0 && t < t_max
+    }
+}
+
+/// The slab method's running interval: entry and exit distance, and the axes of the
+/// faces they lie on.
+struct Slabs {
+    t_near: f32,
+    near_axis: usize,
+    t_far: f32,
+    far_axis: usize,
+}
+
+impl Slabs {
+    /// Narrows the interval by the slab `|o + t·d| ≤ h` of `axis`; `false` when the ray
+    /// runs parallel to it outside (a zero component is handled apart, so that a ray
+    /// lying in a face plane never produces `0·∞ = NaN`).
+    #[inline(always)]
+    fn axis(&mut self, axis: usize, o: f32, d: f32, h: f32) -> bool {
+        if d == 0.0 {
+            return !(o < -h || o > h);
+        }
+        let inv = 1.0 / d;
+        let (mut ta, mut tb) = ((-h - o) * inv, (h - o) * inv);
+        if ta > tb {
+            core::mem::swap(&mut ta, &mut tb);
+        }
+        if ta > self.t_near {
+            self.t_near = ta;
+            self.near_axis = axis;
+        }
+        if tb < self.t_far {
+            self.t_far = tb;
+            self.far_axis = axis;
+        }
+        true
     }
 }
 
