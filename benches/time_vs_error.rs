@@ -191,7 +191,7 @@ fn measure(
             .with_fixed_radius(c.estimator == Estimator::FixedRadius);
         let opts = RenderOptions {
             passes: c.passes,
-            supersample: c.supersample,
+            sampling: caustic::render::Sampling::Grid(c.supersample),
             ..RenderOptions::default()
         };
         let mut times = Vec::new();

@@ -346,13 +346,15 @@ where
         Renderer::new(scene, &store, settings.max_depth())?;
 
     let mut row = vec![Rgb::ZERO; scene.camera().width() as usize];
-    let count = renderer.rows(&mut row, |y, pixels| {
-        DisplaySink::new(&mut *display, tone, dither)
-            .draw_row(y, pixels)
-            .map_err(|e| format!("display error at row {y}: {e:?}"))?;
-        after_row(y, display);
-        Ok::<_, Box<dyn Error>>(())
-    })?;
+    let count = renderer
+        .rows(&mut row, |y, pixels| {
+            DisplaySink::new(&mut *display, tone, dither)
+                .draw_row(y, pixels)
+                .map_err(|e| format!("display error at row {y}: {e:?}"))?;
+            after_row(y, display);
+            Ok::<_, Box<dyn Error>>(())
+        })
+        .map_err(|e| e.to_string())?;
     Ok(Stats {
         emitted: forward.emitted,
         stored: forward.stored,

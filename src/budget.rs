@@ -16,14 +16,20 @@
 //!
 //! ```
 //! use caustic::budget::{DeviceMemory, FIG6};
-//! // Fig. 6 on a device: the scene, a map of FIG6.stored photons, one row of 160 pixels.
-//! let bytes = core::mem::size_of::<DeviceMemory<2, 1, { FIG6.stored }, { FIG6.width as usize }>>();
-//! assert!(bytes <= 12 * 1024, "{bytes}");
+//! // Fig. 6 on a device: the scene, a map of FIG6.stored photons and FIG6.splats
+//! // splats, one row of 160 pixels.
+//! type Fig6 = DeviceMemory<2, 1, { FIG6.stored }, { FIG6.splats }, { FIG6.width as usize }>;
+//! let bytes = core::mem::size_of::<Fig6>();
+//! assert!(bytes <= 24 * 1024, "{bytes}");
 //! ```
 
 use crate::error::Error;
 use crate::math::Rgb;
-use crate::photon::{self, balance, ForwardStats, KdStore, KdTree, Photon, PhotonSettings};
+use crate::photon::{
+    self, balance, CausticStore, ForwardStats, KdStore, KdTree, Photon, PhotonSettings, Splat,
+    SplatStorage,
+};
+use crate::render::Renderer;
 use crate::scene::Scene;
 
 /// A device build's capacities and work. All fields are plain constants so that they
@@ -39,6 +45,9 @@ pub struct DeviceBudget {
     /// Photons the map holds: a forward pass that stores more is an error
     /// ([`Error::Capacity`]), never a truncation.
     pub stored: usize,
+    /// Camera splats the map holds (photons the eye sees directly, light-traced into
+    /// their pixel: the desktop's default estimator); more is an error.
+    pub splats: usize,
     /// Photons per estimate (the gather buffer's capacity `K`).
     pub k: usize,
     /// Gather radius bound, scene units.
@@ -63,13 +72,15 @@ impl DeviceBudget {
 }
 
 /// The paper's Fig. 6 (`demo::fig6`, two objects and one light) on a device:
-/// 160 × 120, 2 048 photons emitted of which 527 are stored (capacity 576, 9 KiB),
-/// `K` = 32 within radius 1 (the cube's edge is 4), 8 specular interactions, seed 0.
+/// 160 × 120, 2 048 photons emitted of which 527 are stored (capacity 576, 9 KiB) and
+/// as many seen by the eye (splats, capacity 576), `K` = 32 within radius 1 (the cube's
+/// edge is 4), 8 specular interactions, seed 0.
 pub const FIG6: DeviceBudget = DeviceBudget {
     width: 160,
     height: 120,
     emitted: 2048,
     stored: 576,
+    splats: 576,
     k: 32,
     max_radius: 1.0,
     depth: 8,
@@ -82,83 +93,126 @@ pub const FIG6_LIGHTS: usize = 1;
 
 /// Compile-time checks of a budget: something is stored, no more than is emitted, the
 /// gather fits the map, and the static memory fits `ram` bytes.
-pub const fn check<const O: usize, const L: usize, const N: usize, const W: usize>(
+pub const fn check<
+    const O: usize,
+    const L: usize,
+    const N: usize,
+    const S: usize,
+    const W: usize,
+>(
     b: &DeviceBudget,
     ram: usize,
 ) -> bool {
     b.stored == N
+        && b.splats == S
         && b.width as usize == W
         && b.stored > 0
         && b.stored <= b.emitted as usize * L
         && b.k > 0
         && b.k <= b.stored
         && b.depth > 0
-        && core::mem::size_of::<DeviceMemory<O, L, N, W>>() <= ram
+        && core::mem::size_of::<DeviceMemory<O, L, N, S, W>>() <= ram
 }
 
 const _: () = assert!(check::<
     FIG6_OBJECTS,
     FIG6_LIGHTS,
     { FIG6.stored },
+    { FIG6.splats },
     { FIG6.width as usize },
->(&FIG6, 12 * 1024));
+>(&FIG6, 24 * 1024));
 const _: () = assert!(core::mem::size_of::<Photon>() <= 16);
 
 /// A photon map that holds at most `STORED` photons of a forward pass that may emit
-/// many more: sized to what lands, not to what is shot. Its whole memory is
-/// `size_of::<DeviceMap<STORED>>()` (16 bytes a photon and three words).
+/// many more (sized to what lands, not to what is shot), and at most `SPLATS` camera
+/// splats. Its whole memory is `size_of::<DeviceMap<STORED, SPLATS>>()` (16 bytes a
+/// photon, 16 a splat, and a few words).
 #[derive(Clone, Debug)]
-pub struct DeviceMap<const STORED: usize> {
+pub struct DeviceMap<const STORED: usize, const SPLATS: usize> {
     photons: [Photon; STORED],
     len: usize,
     unit: f32,
+    splats: heapless::Vec<Splat, SPLATS>,
+    /// Whether the last build connected photons to the eye.
+    splatted: bool,
 }
 
-impl<const STORED: usize> Default for DeviceMap<STORED> {
+impl<const STORED: usize, const SPLATS: usize> Default for DeviceMap<STORED, SPLATS> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const STORED: usize> DeviceMap<STORED> {
+impl<const STORED: usize, const SPLATS: usize> DeviceMap<STORED, SPLATS> {
     /// An empty map (const: it can be a `static`, in `.bss`).
     pub const fn new() -> Self {
         Self {
             photons: [Photon::ZERO; STORED],
             len: 0,
             unit: 0.0,
+            splats: heapless::Vec::new(),
+            splatted: false,
         }
     }
 
-    /// Runs the forward pass (`photon::for_each_photon`, pass 0: the photons
-    /// `PhotonMap::build` stores, in the same order) into this map and balances it. An
-    /// [`Error::Capacity`] naming how many photons landed when more than `STORED` do;
-    /// the map is then empty.
+    /// Runs the forward pass (`photon::forward`, pass 0: the photons `PhotonMap::build`
+    /// stores, in the same order, and with `settings.camera_splats()` the splats of
+    /// those the eye sees) into this map and balances it. An [`Error::Capacity`] when
+    /// more than `STORED` photons land or more than `SPLATS` are seen; the map is then
+    /// empty.
     pub fn build<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
     ) -> Result<ForwardStats, Error> {
-        let (photons, len) = (&mut self.photons, &mut self.len);
+        let (photons, len, splats) = (&mut self.photons, &mut self.len, &mut self.splats);
         *len = 0;
-        let stats = photon::for_each_photon(scene, settings, seed, 0, |p| {
-            if let Some(slot) = photons.get_mut(*len) {
-                *slot = *p;
-            }
-            *len += 1;
-        });
-        if self.len > STORED {
-            self.len = 0;
-            return Err(Error::Capacity {
+        splats.clear_splats();
+        let result = photon::forward(scene, settings, seed, 0, |x| {
+            let slot = photons.get_mut(*len).ok_or(Error::Capacity {
                 what: "photons stored (budget::DeviceBudget::stored)",
-                requested: stats.stored,
+                requested: *len + 1,
                 capacity: STORED,
-            });
-        }
+            })?;
+            *slot = x.photon;
+            *len += 1;
+            match x.splat {
+                Some(s) => splats.push_splat(s),
+                None => Ok(()),
+            }
+        });
+        let stats = match result {
+            Ok(stats) => stats,
+            Err(e) => {
+                self.len = 0;
+                self.splats.clear();
+                return Err(e);
+            }
+        };
         self.unit = stats.power_unit;
+        self.splatted = settings.camera_splats();
         balance(&mut self.photons[..self.len]);
         Ok(stats)
+    }
+
+    /// The camera splats of the last build (empty when it did not splat).
+    pub fn splats(&self) -> &[Splat] {
+        &self.splats
+    }
+
+    /// `renderer` with this map's splats when the build made them (the caustics seen
+    /// directly are then light-traced, the store gathers only behind glass and in
+    /// mirrors); unchanged otherwise (the store gathers at every diffuse hit).
+    pub fn with_splats<'a, S: CausticStore, const O: usize, const L: usize, const D: usize>(
+        &'a self,
+        renderer: Renderer<'a, S, O, L, D>,
+    ) -> Renderer<'a, S, O, L, D> {
+        if self.splatted {
+            renderer.with_splats(&self.splats)
+        } else {
+            renderer
+        }
     }
 
     /// Photons stored.
@@ -187,15 +241,21 @@ impl<const STORED: usize> DeviceMap<STORED> {
 }
 
 /// Everything a device render keeps in RAM outside the stack: the scene (`O` objects,
-/// `L` lights), the photon map (`N` photons) and one row of `W` pixels. The firmware
-/// keeps the map in a `static` and the rest on the stack; this type only states the
-/// sum, so that `size_of` gives it.
+/// `L` lights), the photon map (`N` photons, `S` splats) and one row of `W` pixels.
+/// The firmware keeps the map and the row in statics and the scene on the stack; this
+/// type only states the sum, so that `size_of` gives it.
 #[derive(Debug)]
-pub struct DeviceMemory<const O: usize, const L: usize, const N: usize, const W: usize> {
+pub struct DeviceMemory<
+    const O: usize,
+    const L: usize,
+    const N: usize,
+    const S: usize,
+    const W: usize,
+> {
     /// The scene.
     pub scene: Scene<O, L>,
     /// The photon map.
-    pub map: DeviceMap<N>,
+    pub map: DeviceMap<N, S>,
     /// One row of linear radiance.
     pub row: [Rgb; W],
 }
@@ -210,12 +270,15 @@ mod tests {
     fn the_device_map_stores_what_the_emitted_sized_map_stores() {
         let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(16, 12).unwrap();
         let settings = FIG6.settings().unwrap();
-        let mut small: DeviceMap<{ FIG6.stored }> = DeviceMap::new();
+        let mut small: DeviceMap<{ FIG6.stored }, { FIG6.splats }> = DeviceMap::new();
         let mut full: PhotonMap<{ FIG6.emitted as usize }> = PhotonMap::new();
         let a = small.build(&scene, &settings, FIG6.seed).unwrap();
         let b = full.build(&scene, &settings, FIG6.seed).unwrap();
         assert_eq!(a, b);
         assert_eq!(small.tree().photons(), full.tree().photons());
+        // The eye sees the caustic on the field: splats, within the budget.
+        assert!(settings.camera_splats());
+        assert!(!small.splats().is_empty() && small.splats().len() <= FIG6.splats);
         assert!(
             a.stored <= FIG6.stored && a.stored > FIG6.stored * 3 / 4,
             "{}",
@@ -227,15 +290,25 @@ mod tests {
     fn a_map_too_small_is_an_error_not_a_truncation() {
         let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(16, 12).unwrap();
         let settings = FIG6.settings().unwrap();
-        let mut tiny: DeviceMap<100> = DeviceMap::new();
+        let mut tiny: DeviceMap<100, 600> = DeviceMap::new();
         match tiny.build(&scene, &settings, FIG6.seed) {
             Err(Error::Capacity {
                 requested,
                 capacity: 100,
                 ..
-            }) => assert!(requested > 100),
+            }) => assert_eq!(requested, 101),
             other => panic!("{other:?}"),
         }
         assert!(tiny.is_empty());
+        let mut blind: DeviceMap<600, 10> = DeviceMap::new();
+        match blind.build(&scene, &settings, FIG6.seed) {
+            Err(Error::Capacity {
+                requested: 11,
+                capacity: 10,
+                ..
+            }) => {}
+            other => panic!("{other:?}"),
+        }
+        assert!(blind.is_empty() && blind.splats().is_empty());
     }
 }

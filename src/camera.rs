@@ -22,6 +22,9 @@ pub struct Camera {
 /// The largest image side accepted (keeps pixel arithmetic exact in `f32`).
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
 
+/// Images have fewer pixels than this (a pixel index fits in 31 bits).
+pub const MAX_PIXELS: u64 = 1 << 31;
+
 impl Camera {
     /// A camera looking from `position` at `look_at`, `fov_y_deg` in (0, 180) degrees,
     /// rendering `width × height` pixels.
@@ -51,6 +54,14 @@ impl Camera {
                     max: MAX_IMAGE_SIDE as f32,
                 });
             }
+        }
+        if width as u64 * height as u64 >= MAX_PIXELS {
+            return Err(Error::OutOfRange {
+                what: "image width × height",
+                value: (width as u64 * height as u64) as f32,
+                min: 1.0,
+                max: MAX_PIXELS as f32,
+            });
         }
         let half_h = libm::tanf(0.5 * fov * (core::f32::consts::PI / 180.0));
         let half_w = half_h * width as f32 / height as f32;
@@ -120,6 +131,79 @@ impl Camera {
     }
 }
 
+/// Where a surface point appears on the image, for light tracing (connecting a photon to
+/// the eye): the pixel it projects into and the factor that turns the flux `Φ` the point
+/// reflects per unit of its BRDF into that pixel's average radiance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// Pixel index `y·W + x`.
+    pub pixel: u32,
+    /// The pixel's row (0 = top).
+    pub row: u32,
+    /// `|n·(e − p)| / (A·z³)`, 1/m²: see [`Camera::project`].
+    pub factor: f32,
+    /// Unit direction from the point towards the eye.
+    pub to_eye: UnitVec3,
+    /// Distance from the point to the eye.
+    pub distance: f32,
+}
+
+impl Camera {
+    /// Area of one pixel on the image plane at distance 1: `(2·half_w/W)·(2·half_h/H)`.
+    #[inline]
+    pub fn pixel_area(&self) -> f32 {
+        (2.0 * self.half_w / self.width as f32) * (2.0 * self.half_h / self.height as f32)
+    }
+
+    /// The angle one pixel spans at the image centre, radians (`2·half_h/H`): the width
+    /// of a pixel's ray cone per unit of distance travelled.
+    #[inline]
+    pub fn pixel_angle(&self) -> f32 {
+        2.0 * self.half_h / self.height as f32
+    }
+
+    /// Projects the surface point `p` of normal `n` through the pinhole: the inverse of
+    /// [`ray_at`](Self::ray_at). `None` behind the eye or outside the image.
+    ///
+    /// A pixel's value is the average over its area `A` (on the image plane, at unit
+    /// distance) of the radiance seen through it. An image-plane patch `dA_film` sees a surface
+    /// patch `dA = dA_film·d²·cos³θ_c / cosθ`, with `d` the distance to the eye, `θ_c`
+    /// the angle off the optical axis and `θ` the angle at the surface, so a flux `Φ`
+    /// arriving at `p` on a surface of BRDF `f` adds `f·Φ·cosθ/(A·d²·cos³θ_c)` to the
+    /// pixel. With `z = (p − e)·forward = d·cosθ_c` and `cosθ = |n·(e − p)|/d` that is
+    /// `f·Φ·|n·(e − p)|/(A·z³)`: the importance of a pinhole camera (Veach 1997 §10;
+    /// pbrt-v4 §5.4.1). `factor` is `|n·(e − p)|/(A·z³)`.
+    pub fn project(&self, p: Vec3, n: UnitVec3) -> Option<Projection> {
+        let d = p - self.position;
+        let z = d.dot(self.forward);
+        if !(z > 0.0) {
+            return None;
+        }
+        let u = d.dot(self.right) / z;
+        let v = d.dot(self.up) / z;
+        let px = (u / self.half_w + 1.0) * (0.5 * self.width as f32);
+        let py = (1.0 - v / self.half_h) * (0.5 * self.height as f32);
+        // `!(a < b)` also rejects NaN.
+        if !(px >= 0.0 && py >= 0.0 && px < self.width as f32 && py < self.height as f32) {
+            return None;
+        }
+        let (x, y) = (
+            (px as u32).min(self.width - 1),
+            (py as u32).min(self.height - 1),
+        );
+        let distance = crate::math::sqrt(d.length_squared());
+        let to_eye = UnitVec3::new(-d)?;
+        let factor = n.dot(-d).abs() / (self.pixel_area() * z * z * z);
+        factor.is_finite().then_some(Projection {
+            pixel: y * self.width + x,
+            row: y,
+            factor,
+            to_eye,
+            distance,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,5 +229,57 @@ mod tests {
         );
         assert!(Camera::new(Vec3::ZERO, Vec3::X, Vec3::Y, 0.0, 4, 4).is_err());
         assert!(Camera::new(Vec3::ZERO, Vec3::X, Vec3::Y, 40.0, 0, 4).is_err());
+    }
+
+    #[test]
+    fn projection_inverts_the_pixel_ray() {
+        let c = Camera::new(
+            Vec3::new(0.3, 4.0, 7.0),
+            Vec3::new(0.0, 0.6, 0.0),
+            Vec3::Y,
+            40.0,
+            32,
+            24,
+        )
+        .unwrap();
+        for (x, y, fx, fy) in [(0, 0, 0.1, 0.9), (31, 23, 0.7, 0.2), (13, 7, 0.5, 0.5)] {
+            let ray = c.ray_at(x, y, fx, fy);
+            let p = ray.at(3.7);
+            let pr = c.project(p, UnitVec3::Y).unwrap();
+            assert_eq!((pr.pixel, pr.row), (y * 32 + x, y));
+            assert!((pr.distance - 3.7).abs() < 1e-5);
+            assert!((pr.to_eye.get() + ray.dir.get()).length() < 1e-5);
+        }
+        assert!(
+            c.project(Vec3::new(0.0, 4.0, 9.0), UnitVec3::Y).is_none(),
+            "behind"
+        );
+    }
+
+    /// The factor is the pixel's footprint turned around: a plane lit with uniform
+    /// irradiance E, sampled by photons of flux E·dA, gives each pixel Σ factor·E·dA =
+    /// E, so the factor integrates to 1 over the footprint of the pixel (brute force).
+    #[test]
+    fn projection_factor_integrates_to_one_over_a_pixel_footprint() {
+        let c = Camera::new(Vec3::new(0.0, 4.0, 7.0), Vec3::ZERO, Vec3::Y, 40.0, 16, 12).unwrap();
+        let target = 5 * 16 + 9; // pixel (9, 5)
+        let (n, half) = (800, 4.0);
+        let step = 2.0 * half / n as f32;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let p = Vec3::new(
+                    -half + (i as f32 + 0.5) * step,
+                    0.0,
+                    -half + (j as f32 + 0.5) * step,
+                );
+                if let Some(pr) = c.project(p, UnitVec3::Y) {
+                    if pr.pixel == target {
+                        sum += (pr.factor * step * step) as f64;
+                    }
+                }
+            }
+        }
+        assert!((sum - 1.0).abs() < 0.02, "{sum}");
     }
 }

@@ -118,6 +118,22 @@ impl Material {
             Material::Mirror(_) | Material::Dielectric(_) => false,
         }
     }
+
+    /// How a surface turns caustic light into radiance towards the eye: the radiance
+    /// leaving towards `to_eye` per unit of flux density (W/m²) arriving from
+    /// `to_light`. Diffuse: the BRDF `ρ/π`. Classic: `π·kernel` — the paper's eq. 8
+    /// divides `Σ kernel·Φ` by `r²`, that is `π·kernel` times the flux density
+    /// `Σ Φ/(πr²)`. Mirror and glass: none (light through them is traced on).
+    /// Both the gather (a density times this) and the light tracer (a photon's flux
+    /// times the camera's importance times this) ask it.
+    #[inline]
+    pub fn caustic_response(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
+        match self {
+            Material::Diffuse(m) => m.albedo * core::f32::consts::FRAC_1_PI,
+            Material::Classic(c) => c.kernel(n, to_light, to_eye) * core::f32::consts::PI,
+            Material::Mirror(_) | Material::Dielectric(_) => Rgb::ZERO,
+        }
+    }
 }
 
 impl Classic {

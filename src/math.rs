@@ -4,7 +4,7 @@
 //! `libm`, never through the platform's own maths library, so that an x86-64 desktop
 //! and a Cortex-M4F compute the same bits. No `mul_add`: Rust never fuses `a * b + c`.
 
-use core::ops::{Add, AddAssign, Mul, MulAssign, Neg};
+use core::ops::{Add, AddAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
 use crate::error::{finite, Error};
 pub use glam::{Mat3, Vec3};
@@ -368,6 +368,21 @@ impl AddAssign for Rgb {
     #[inline]
     fn add_assign(&mut self, o: Rgb) {
         *self = *self + o;
+    }
+}
+
+impl Sub for Rgb {
+    type Output = Rgb;
+    #[inline]
+    fn sub(self, o: Rgb) -> Rgb {
+        Rgb::new(self.r - o.r, self.g - o.g, self.b - o.b)
+    }
+}
+
+impl SubAssign for Rgb {
+    #[inline]
+    fn sub_assign(&mut self, o: Rgb) {
+        *self = *self - o;
     }
 }
 

@@ -60,7 +60,7 @@ fn measure(name: &str, reference: &str, mode: Mode) -> Measured {
         Mode::Nearest { supersample } => (
             PhotonSettings::new(100_000, 64, 0.1, depth).unwrap(),
             RenderOptions {
-                supersample,
+                sampling: caustic::render::Sampling::Grid(supersample),
                 ..RenderOptions::default()
             },
             format!("k-nearest, {supersample}x{supersample} spp"),

@@ -2,13 +2,18 @@
 //! across threads, and the scene files' error messages.
 
 use caustic::camera::Camera;
+use caustic::desktop::image::compare;
+use caustic::desktop::run::{render_rows, PhotonBuffer, Progress};
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
+use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Ray, Shape};
 use caustic::light::PointLight;
+use caustic::material::Classic;
 use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
+use caustic::photon;
 use caustic::photon::{NoCaustics, PhotonSettings};
-use caustic::render::{RayCount, Renderer};
+use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
 
 fn read(name: &str) -> String {
@@ -164,6 +169,180 @@ fn max_depth_ends_paths_at_a_further_specular_surface() {
         Renderer::<_, 2, 1, 8>::new(&scene, &NoCaustics, 9).is_err(),
         "max_depth beyond the stack"
     );
+}
+
+/// The glass sphere rendered with the default throughput cut-off and ray budget, and
+/// with neither (cut-off 0, a budget no pixel reaches), against the same caustic store:
+/// what the pruning leaves out stays below 1e-3 of the image (relative RMSE).
+#[test]
+fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
+    let (scene, mut settings) = small("glass_sphere.json", 64, 48);
+    settings = PhotonSettings::new(20_000, 64, 0.05, settings.max_depth()).unwrap();
+    let mut stats = caustic::desktop::RenderStats::default();
+    let mut photons = PhotonBuffer::for_budget(&scene, &settings).unwrap();
+    photons
+        .fill(&scene, &settings, 1, 0, 2, &mut stats)
+        .unwrap();
+    let store = photon::store_over::<128>(photons.tree(), photons.unit(), &settings).unwrap();
+    let image = |cutoff: f32, budget: u32| {
+        let r: Renderer<'_, _, { MAX_OBJECTS }, { MAX_LIGHTS }, { MAX_DEPTH }> =
+            Renderer::new(&scene, &store, settings.max_depth())
+                .unwrap()
+                .with_cutoff(cutoff)
+                .unwrap()
+                .with_ray_budget(budget)
+                .unwrap();
+        let mut img = caustic::desktop::Image::new(64, 48);
+        let rays = render_rows(&r, &mut img, 2, &Progress::new(false, 48));
+        (img, rays)
+    };
+    let (pruned, pruned_rays) = image(DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET);
+    let (full, full_rays) = image(0.0, u32::MAX);
+    let e = compare(&pruned, &full, None).unwrap();
+    println!(
+        "rel RMSE {:.2e}; eye rays {} pruned, {} full",
+        e.rel_rmse, pruned_rays.eye, full_rays.eye
+    );
+    assert!(e.rel_rmse < 1e-3, "rel RMSE {}", e.rel_rmse);
+    // The cut-off did prune something (else this test measures nothing).
+    assert!(pruned_rays.eye < full_rays.eye);
+}
+
+/// Overlapping classic spheres, each both reflective and transparent, inside a
+/// classic box, at `max_depth` 30: 2^30 branches per pixel without a bound. With the
+/// cut-off off, every pixel's rays (eye + shadow) stay within the budget, and spend
+/// most of it; with the default cut-off too.
+#[test]
+fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
+    let camera = Camera::new(
+        Vec3::new(0.0, 0.0, 0.5),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::Y,
+        60.0,
+        16,
+        12,
+    )
+    .unwrap();
+    let mut scene: Scene<8, 2> = Scene::new(camera);
+    let glassy = Material::classic(Classic::new(
+        Rgb::splat(0.9),
+        0.1,
+        0.5,
+        0.5,
+        20.0,
+        0.5,
+        0.5,
+        1.5,
+    ))
+    .unwrap();
+    for (x, y, z) in [
+        (0.0, 0.0, -1.0),
+        (0.4, 0.1, -1.2),
+        (-0.3, -0.2, -0.8),
+        (0.1, 0.3, -1.5),
+    ] {
+        scene
+            .add(Shape::sphere(Vec3::new(x, y, z), 0.5).unwrap(), glassy)
+            .unwrap();
+    }
+    let walls =
+        Material::classic(Classic::new(Rgb::ONE, 0.1, 0.2, 0.0, 1.0, 0.8, 0.2, 1.2)).unwrap();
+    scene
+        .add(
+            Shape::cuboid(Vec3::new(0.0, 0.0, -1.0), Vec3::splat(6.0), Vec3::ZERO).unwrap(),
+            walls,
+        )
+        .unwrap();
+    scene
+        .add_light(PointLight::new(Vec3::new(0.5, 1.0, 0.0), Rgb::splat(5.0)).unwrap())
+        .unwrap();
+    scene
+        .add_light(PointLight::new(Vec3::new(-1.0, -1.0, -1.0), Rgb::splat(2.0)).unwrap())
+        .unwrap();
+    for (cutoff, budget) in [
+        (0.0, 300),
+        (0.0, DEFAULT_RAY_BUDGET),
+        (DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET),
+    ] {
+        let r: Renderer<_, 8, 2, 32> = Renderer::new(&scene, &NoCaustics, 30)
+            .unwrap()
+            .with_cutoff(cutoff)
+            .unwrap()
+            .with_ray_budget(budget)
+            .unwrap();
+        let mut most = 0;
+        for y in 0..12 {
+            for x in 0..16 {
+                let mut count = RayCount::default();
+                let l = r.radiance(camera.ray(x, y), &mut count);
+                assert!(l.is_finite());
+                let rays = count.eye + count.shadow;
+                assert!(
+                    rays <= budget as u64,
+                    "pixel ({x}, {y}): {rays} rays > {budget}"
+                );
+                most = most.max(rays);
+            }
+        }
+        println!("cut-off {cutoff}, budget {budget}: at most {most} rays in a pixel");
+        if cutoff == 0.0 {
+            // Without the cut-off the tree is far larger than any budget: it is the
+            // budget that stopped it, within one eye ray and its shadow rays.
+            assert!(most + 3 > budget as u64, "{most}");
+        }
+    }
+    // A budget that cannot shade one camera ray (1 eye + 2 shadow rays) is refused.
+    assert!(Renderer::<_, 8, 2, 32>::new(&scene, &NoCaustics, 30)
+        .unwrap()
+        .with_ray_budget(2)
+        .is_err());
+}
+
+/// `rows` refuses a row buffer shorter than the width (no cropped image) and hands the
+/// sink exactly `width` pixels from a longer one.
+#[test]
+fn rows_refuses_a_short_row_buffer() {
+    let camera = Camera::new(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0, 8, 2).unwrap();
+    let mut scene: Scene<1, 1> = Scene::new(camera);
+    scene
+        .add(
+            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
+            Material::diffuse(Rgb::ONE).unwrap(),
+        )
+        .unwrap();
+    let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
+    let mut short = [Rgb::ZERO; 7];
+    let mut called = false;
+    let e = r
+        .rows(&mut short, |_, _| -> Result<(), ()> {
+            called = true;
+            Ok(())
+        })
+        .unwrap_err();
+    assert!(!called, "nothing is rendered into a short buffer");
+    match e {
+        RowsError::Render(caustic::Error::Capacity {
+            requested,
+            capacity,
+            ..
+        }) => {
+            assert_eq!((requested, capacity), (8, 7))
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut long = [Rgb::ZERO; 10];
+    let mut widths = Vec::new();
+    r.rows(&mut long, |_, px| -> Result<(), ()> {
+        widths.push(px.len());
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(widths, [8, 8]);
+    // The sink's own error comes back as such, at its first row.
+    let e = r
+        .rows(&mut long, |y, _| if y == 1 { Err(y) } else { Ok(()) })
+        .unwrap_err();
+    assert_eq!(e, RowsError::Sink(1));
 }
 
 fn small(name: &str, w: u32, h: u32) -> (DesktopScene, PhotonSettings) {

@@ -4,7 +4,8 @@
 //! caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
 //!                [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
 //!                [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-//!                [--exposure E] [--supersample S] [--emit cones|sphere] [--gather nearest|radius]
+//!                [--exposure E] [--supersample S] [--sampling adaptive|centre|grid]
+//!                [--splat on|off] [--emit cones|sphere] [--gather nearest|radius]
 //!                [--stats] [--quiet]
 //!                [--store kd|illum] [--texel-size S]
 //! caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]
@@ -21,12 +22,14 @@ use caustic::desktop::scene_file::StoreChoice;
 use caustic::desktop::{load_scene, render, RenderOptions, RenderStats};
 use caustic::photon::{ConeFilter, MapStats, PhotonSettings};
 use caustic::raster::ToneMap;
+use caustic::render::Sampling;
 
 const USAGE: &str = "usage:
   caustic render SCENE.json -o OUT.png [--pfm OUT.pfm] [--width W] [--height H]
                  [--photons N] [--k K] [--radius R] [--max-depth D] [--passes P]
                  [--alpha A] [--cone-filter K] [--seed S] [--threads T]
-                 [--exposure E] [--supersample S] [--emit cones|sphere] [--gather nearest|radius]
+                 [--exposure E] [--supersample S] [--sampling adaptive|centre|grid]
+                 [--splat on|off] [--emit cones|sphere] [--gather nearest|radius]
                  [--stats] [--quiet]
                  [--store kd|illum] [--texel-size S]
   caustic compare A.pfm REFERENCE.pfm [--mask M.pfm] [--mask-fraction F] [--bin B]";
@@ -136,7 +139,9 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
     let seed: u64 = f.value(&["--seed"])?.unwrap_or(0);
     let threads: Option<usize> = f.value(&["--threads"])?;
     let exposure: f32 = f.value(&["--exposure"])?.unwrap_or(1.0);
-    let supersample: u32 = f.value(&["--supersample"])?.unwrap_or(1);
+    let supersample: Option<u32> = f.value(&["--supersample"])?;
+    let sampling: Option<String> = f.value(&["--sampling"])?;
+    let splat: Option<String> = f.value(&["--splat"])?;
     let emit: Option<String> = f.value(&["--emit"])?;
     let gather: Option<String> = f.value(&["--gather"])?;
     let store: Option<String> = f.value(&["--store"])?;
@@ -196,10 +201,28 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
             )))
         }
     };
+    let splat = match splat.as_deref() {
+        None | Some("on") => true,
+        Some("off") => false,
+        Some(other) => return Err(bad_input(format!("--splat takes on or off, not {other}"))),
+    };
+    let refine = supersample.unwrap_or(caustic::render::REFINE);
+    let sampling = match sampling.as_deref() {
+        None if supersample.is_some() => Sampling::Grid(refine),
+        None | Some("adaptive") => Sampling::Adaptive(refine),
+        Some("centre") | Some("center") => Sampling::Centre,
+        Some("grid") => Sampling::Grid(refine),
+        Some(other) => {
+            return Err(bad_input(format!(
+                "--sampling takes adaptive, centre or grid, not {other}"
+            )))
+        }
+    };
     let settings = settings
         .with_cone_filter(cone)
         .with_full_sphere(full_sphere)
-        .with_fixed_radius(fixed_radius);
+        .with_fixed_radius(fixed_radius)
+        .with_camera_splats(splat);
     let alpha = alpha.unwrap_or(loaded.alpha);
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(bad_input("--alpha must lie in (0, 1)"));
@@ -212,7 +235,7 @@ fn cmd_render(args: &[String]) -> Result<(), Failure> {
         progress: !quiet,
         passes: passes.unwrap_or(loaded.passes).max(1),
         alpha,
-        supersample,
+        sampling,
     };
     let parse_ms = t0.elapsed().as_secs_f64() * 1e3;
     // The caustic store: --store, else the scene file's; illumination maps take
@@ -291,8 +314,8 @@ fn stats_json(s: &RenderStats, parse_ms: f64, write_ms: f64, total_ms: f64) -> S
             "{{\"width\":{},\"height\":{},\"threads\":{},\"passes\":{},",
             "\"time_ms\":{{\"parse\":{:.3},\"emit\":{:.3},\"balance\":{:.3},\"render\":{:.3},",
             "\"gather_cpu\":{:.3},\"write\":{:.3},\"total\":{:.3}}},",
-            "\"rays\":{{\"eye\":{},\"shadow\":{}}},",
-            "\"photons\":{{\"emitted\":{},\"stored\":{}}}}}"
+            "\"rays\":{{\"eye\":{},\"shadow\":{},\"refined_pixels\":{}}},",
+            "\"photons\":{{\"emitted\":{},\"stored\":{},\"splatted\":{}}}}}"
         ),
         s.width,
         s.height,
@@ -307,8 +330,10 @@ fn stats_json(s: &RenderStats, parse_ms: f64, write_ms: f64, total_ms: f64) -> S
         total_ms,
         s.rays.eye,
         s.rays.shadow,
+        s.rays.refined,
         s.photons_emitted,
-        s.photons_stored
+        s.photons_stored,
+        s.photons_splatted
     )
 }
 

@@ -15,9 +15,10 @@ use super::{DesktopScene, MAX_DEPTH, MAX_GATHER, MAX_PHOTONS};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::photon::{
-    self, balance, photons_needed, CausticStore, Emitter, KdTree, Photon, PhotonSettings,
+    self, add_to_frame, balance, photons_needed, CausticStore, Emitter, KdTree, Landed, Photon,
+    PhotonSettings, Splat,
 };
-use crate::render::{RayCount, Renderer};
+use crate::render::{RayCount, Renderer, Sampling, REFINE};
 use crate::scene::Scene;
 use crate::Error;
 
@@ -34,8 +35,8 @@ pub struct RenderOptions {
     pub passes: u32,
     /// Radius shrink exponent α of the passes: `r_i² = r_1²·i^(α−1)`.
     pub alpha: f32,
-    /// Eye rays per pixel side (`n × n` per pixel), ≥ 1.
-    pub supersample: u32,
+    /// How each pixel's area is sampled (default: adaptive, corners then a 4 × 4 grid).
+    pub sampling: Sampling,
 }
 
 impl Default for RenderOptions {
@@ -46,7 +47,7 @@ impl Default for RenderOptions {
             progress: false,
             passes: 1,
             alpha: 2.0 / 3.0,
-            supersample: 1,
+            sampling: Sampling::Adaptive(REFINE),
         }
     }
 }
@@ -81,6 +82,8 @@ pub struct RenderStats {
     pub photons_emitted: u64,
     /// Photons stored (all passes).
     pub photons_stored: u64,
+    /// Photons the camera sees directly, splatted into their pixels (all passes).
+    pub photons_splatted: u64,
 }
 
 /// A store that times its gathers (summed over threads).
@@ -117,6 +120,7 @@ pub struct PhotonBuffer {
     photons: vec::Vec<Photon>,
     len: usize,
     unit: f32,
+    splats: vec::Vec<Splat>,
 }
 
 /// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
@@ -195,6 +199,7 @@ impl PhotonBuffer {
             photons: vec![Photon::ZERO; needed],
             len: 0,
             unit: 0.0,
+            splats: vec::Vec::new(),
         })
     }
 
@@ -229,7 +234,7 @@ impl PhotonBuffer {
                     .map(move |s| (l, s, (s + CHUNK).min(n)))
             })
             .collect();
-        let results: vec::Vec<Mutex<vec::Vec<Photon>>> =
+        let results: vec::Vec<Mutex<vec::Vec<Landed>>> =
             items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
@@ -239,8 +244,8 @@ impl PhotonBuffer {
                     let Some(&(l, start, end)) = items.get(k) else {
                         break;
                     };
-                    let local: vec::Vec<Photon> =
-                        (start..end).filter_map(|i| emitter.photon(l, i)).collect();
+                    let local: vec::Vec<Landed> =
+                        (start..end).filter_map(|i| emitter.land(l, i)).collect();
                     if let Ok(mut slot) = results[k].lock() {
                         *slot = local;
                     }
@@ -248,10 +253,13 @@ impl PhotonBuffer {
             }
         });
         let mut stored = 0;
+        self.splats.clear();
         for r in results {
-            let chunk = r.into_inner().unwrap_or_default();
-            self.photons[stored..stored + chunk.len()].copy_from_slice(&chunk);
-            stored += chunk.len();
+            for x in r.into_inner().unwrap_or_default() {
+                self.photons[stored] = x.photon;
+                stored += 1;
+                self.splats.extend(x.splat);
+            }
         }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
@@ -259,6 +267,7 @@ impl PhotonBuffer {
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
         stats.photons_stored += stored as u64;
+        stats.photons_splatted += self.splats.len() as u64;
         self.len = stored;
         self.unit = emitter.power_unit();
         Ok(())
@@ -272,6 +281,11 @@ impl PhotonBuffer {
     /// Power of one stored unit, W.
     pub fn unit(&self) -> f32 {
         self.unit
+    }
+
+    /// The camera splats of the last pass, in emission order.
+    pub fn splats(&self) -> &[Splat] {
+        &self.splats
     }
 }
 
@@ -309,8 +323,16 @@ pub fn render(
         photons.fill(scene, &pass_settings, opts.seed, pass, threads, &mut stats)?;
         let store =
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
+        let splats = settings.camera_splats().then(|| photons.splats());
         backward_pass(
-            scene, &store, settings, opts, &mut image, &progress, &mut stats,
+            scene,
+            &store,
+            settings,
+            (splats, shrink),
+            opts,
+            &mut image,
+            &progress,
+            &mut stats,
         )?;
         for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
             *s += *p;
@@ -328,10 +350,16 @@ pub fn render(
 
 /// The backward pass against one caustic store, into `image`, on `opts.threads`
 /// threads, adding its time, its gather time and its rays to `stats`.
+///
+/// With `splats` (the camera splats of the forward pass, and the pass's radius shrink
+/// factor) the store gathers only behind glass and mirrors, and the splats are added to
+/// the image, in emission order, after its rows.
+#[allow(clippy::too_many_arguments)]
 fn backward_pass<S: CausticStore + Sync>(
     scene: &DesktopScene,
     store: &S,
     settings: &PhotonSettings,
+    (splats, shrink): (Option<&[Splat]>, f32),
     opts: &RenderOptions,
     image: &mut Image,
     progress: &Progress,
@@ -341,10 +369,18 @@ fn backward_pass<S: CausticStore + Sync>(
         inner: store,
         nanos: AtomicU64::new(0),
     };
-    let renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
-        Renderer::new(scene, &timed, settings.max_depth())?.with_supersample(opts.supersample)?;
+    let mut renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
+        Renderer::new(scene, &timed, settings.max_depth())?
+            .with_sampling(opts.sampling)?
+            .with_footprint_scale(shrink);
+    if let Some(splats) = splats {
+        renderer = renderer.with_splats(splats);
+    }
     let t = Instant::now();
     stats.rays += render_rows(&renderer, image, opts.threads.max(1), progress);
+    if let Some(splats) = splats {
+        add_to_frame(splats, &mut image.pixels);
+    }
     stats.render_ms += ms(t.elapsed());
     stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
     Ok(())
@@ -476,7 +512,8 @@ pub fn render_illumination(
     let needed = desktop_budget(scene, settings)?;
     let t = Instant::now();
     let mut photons = vec![Photon::ZERO; needed];
-    let f = photon::shoot(scene, settings, opts.seed, 0, &mut photons)?;
+    let mut splats = vec::Vec::new();
+    let f = photon::shoot_with_splats(scene, settings, opts.seed, 0, &mut photons, &mut splats)?;
     stats.emit_ms += ms(t.elapsed());
     stats.photons_emitted = f.emitted;
     stats.photons_stored = f.stored as u64;
@@ -488,8 +525,17 @@ pub fn render_illumination(
     stats.balance_ms += ms(t.elapsed());
     let progress = Progress::new(opts.progress && std::io::stderr().is_terminal(), h as usize);
     let mut image = Image::new(w, h);
+    let splats = settings.camera_splats().then_some(&splats[..]);
+    stats.photons_splatted = splats.map_or(0, |s| s.len() as u64);
     backward_pass(
-        scene, &maps, settings, opts, &mut image, &progress, &mut stats,
+        scene,
+        &maps,
+        settings,
+        (splats, 1.0),
+        opts,
+        &mut image,
+        &progress,
+        &mut stats,
     )?;
     progress.finish();
     Ok((image, stats, map_stats))

@@ -101,6 +101,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
         &self,
         x: Vec3,
         n: UnitVec3,
+        max_radius2: f32,
         mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
         let photons = self.tree.photons();
@@ -128,13 +129,13 @@ impl<'a, const K: usize> KdStore<'a, K> {
         let (r2, norm) = match self.k {
             Some(k) => {
                 let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
-                let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
+                let found = self.tree.k_nearest(x, max_radius2, k, &mut buf);
                 // Photon positions are known to about ε·|x|, and no estimate resolves
                 // detail below 10⁻⁴ of the gather radius: k photons all at the query
                 // point would otherwise divide by r² = 0. Floor r² there.
                 let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
                 let floor = crate::math::max(
-                    crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
+                    crate::math::max(ulp * ulp, 1e-8 * max_radius2),
                     f32::MIN_POSITIVE,
                 );
                 let r2 = crate::math::max(found.radius2, floor);
@@ -145,7 +146,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 (r2, norm)
             }
             None => {
-                let r2 = self.max_radius2;
+                let r2 = max_radius2;
                 let (inv_kr, norm) = filter(r2);
                 self.tree.search(x, r2, |index, dist2| {
                     add(index, dist2, inv_kr);
@@ -155,6 +156,40 @@ impl<'a, const K: usize> KdStore<'a, K> {
             }
         };
         (sum * (self.unit * norm), r2)
+    }
+}
+
+impl<const K: usize> KdStore<'_, K> {
+    /// The gather radius² bound: the store's maximum radius, or `radius` if smaller
+    /// (but never a radius whose square is not a normal float).
+    #[inline]
+    fn bound2(&self, radius: f32) -> f32 {
+        let r2 = radius * radius;
+        if r2 >= f32::MIN_POSITIVE && r2 < self.max_radius2 {
+            r2
+        } else {
+            self.max_radius2
+        }
+    }
+
+    /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons within `√r2_max`.
+    #[inline]
+    fn irradiance2(&self, x: Vec3, n: UnitVec3, r2_max: f32) -> Rgb {
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, r2_max, |_, power| power);
+        sum * (1.0 / (PI * r2))
+    }
+
+    /// Paper eq. 8 over the photons within `√r2_max`.
+    #[inline]
+    fn classic2(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic, r2_max: f32) -> Rgb {
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, r2_max, |dir, power| m.kernel(n, -dir, to_eye) * power);
+        sum * (1.0 / r2)
     }
 }
 
@@ -178,20 +213,29 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// divided by the diffuse BRDF.
     #[inline]
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        if self.out_of_reach(x) {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |_, power| power);
-        sum * (1.0 / (PI * r2))
+        self.irradiance2(x, n, self.max_radius2)
     }
 
     /// Paper eq. 8: `c = (1/r²) Σ (max(n·l,0)·k_d·color + max(n·h,0)^a·k_s·color)·energy`.
     #[inline]
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        if self.out_of_reach(x) {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
-        sum * (1.0 / r2)
+        self.classic2(x, n, to_eye, m, self.max_radius2)
+    }
+
+    #[inline]
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
+        self.irradiance2(x, n, self.bound2(radius))
+    }
+
+    #[inline]
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        to_eye: UnitVec3,
+        m: &Classic,
+        radius: f32,
+    ) -> Rgb {
+        self.classic2(x, n, to_eye, m, self.bound2(radius))
     }
 }

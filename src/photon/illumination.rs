@@ -20,15 +20,26 @@
 //! layout needs (`Vec<Rgb>`). No photon array is needed: [`IlluminationMaps::build`]
 //! re-runs the (deterministic) forward pass instead of storing photons.
 //!
+//! # Any scene fits its texel budget
+//! Texels cover only where photons land: a plane gets the (trimmed) rectangle of its
+//! photons, an object without photons gets none. When even that takes more texels than
+//! the budget ([`IlluminationMaps::with_texel_budget`]; by default the whole fixed array,
+//! or [`DEFAULT_HEAP_TEXELS`] on the desktop), the budget is shared among the objects in
+//! proportion to the photons they received, and an object over its share gets a coarser
+//! texel — the smallest that fits (a back wall hit by a few scattered photons coarsens;
+//! the floor under the caustic keeps the requested size). [`MapStats`] says what was
+//! requested and chosen; [`IlluminationMaps::object_texel_size`] gives each object's.
+//!
 //! # Charts
 //! - **plane**: a rectangle of the plane in the basis `(e1, e2)` = [`UnitVec3::basis`]
 //!   of its normal, the bounding rectangle of the photons that landed on its front,
 //!   trimmed of outliers by [`IlluminationMaps::with_trim`] (photons outside it are
-//!   dropped and counted in [`MapStats::dropped`]); texels exactly `texel_size` square
-//!   (the paper's "scale").
+//!   dropped and counted in [`MapStats::dropped`]); texels exactly the object's texel
+//!   side square (the paper's "scale").
 //! - **sphere**: paper eq. 7, `P(u, v) = c + r·(cos v cos u, sin v, cos v sin u)` (the
 //!   paper's `z` axis is the scene's up, `y`), longitude `u ∈ [0, 2π)` (periodic),
-//!   latitude `v ∈ [−π/2, π/2]`; `⌈2πr/s⌉ × ⌈πr/s⌉` texels, texel area
+//!   latitude `v ∈ [−π/2, π/2]`; `⌈2πr/s⌉ × ⌈πr/s⌉` texels (`s` the object's texel
+//!   side), texel area
 //!   `r²·Δu·∫ w(v) cos v dv`.
 //! - **box**: each face its own grid, in the box's frame.
 //! - **cylinder**: the side (angle × height, area `r·Δθ·Δz`), and each cap in polar
@@ -72,6 +83,13 @@ pub trait TexelStorage {
     fn texels_mut(&mut self) -> &mut [Rgb];
     /// Makes room for `needed` texels: an error when a fixed storage is too small.
     fn reserve(&mut self, needed: usize) -> Result<(), Error>;
+    /// Most texels [`reserve`](Self::reserve) accepts.
+    fn capacity(&self) -> usize;
+    /// The texel budget a layout fits into unless
+    /// [`IlluminationMaps::with_texel_budget`] says otherwise: the whole capacity.
+    fn default_budget(&self) -> usize {
+        self.capacity()
+    }
 }
 
 impl<const N: usize> TexelStorage for [Rgb; N] {
@@ -91,11 +109,20 @@ impl<const N: usize> TexelStorage for [Rgb; N] {
         }
         Ok(())
     }
+    fn capacity(&self) -> usize {
+        N
+    }
 }
 
 /// Most texels a heap-backed (desktop) map may hold: 2²⁶ texels, 768 MiB.
 #[cfg(feature = "std")]
 pub const MAX_HEAP_TEXELS: usize = 1 << 26;
+
+/// The default texel budget of a heap-backed (desktop) map: 2²² texels, 48 MiB — at
+/// texel 0.02 about 1 700 scene units² at full resolution; larger layouts are coarsened
+/// to fit (see [`IlluminationMaps`]).
+#[cfg(feature = "std")]
+pub const DEFAULT_HEAP_TEXELS: usize = 1 << 22;
 
 #[cfg(feature = "std")]
 impl TexelStorage for std::vec::Vec<Rgb> {
@@ -119,6 +146,12 @@ impl TexelStorage for std::vec::Vec<Rgb> {
         self.resize(needed, Rgb::ZERO);
         self.shrink_to_fit();
         Ok(())
+    }
+    fn capacity(&self) -> usize {
+        MAX_HEAP_TEXELS
+    }
+    fn default_budget(&self) -> usize {
+        DEFAULT_HEAP_TEXELS
     }
 }
 
@@ -151,6 +184,8 @@ struct ObjectMap {
     /// A plane's photon rectangle in `(u, v)`: min and max.
     lo: [f32; 2],
     hi: [f32; 2],
+    /// Its texel side: the requested one, or coarser to fit the budget.
+    texel: f32,
 }
 
 /// What building the maps did.
@@ -168,6 +203,17 @@ pub struct MapStats {
     pub texels: usize,
     /// Diffuse objects with texels.
     pub mapped_objects: usize,
+    /// The texel budget the layout had to fit
+    /// ([`IlluminationMaps::with_texel_budget`]).
+    pub texel_budget: usize,
+    /// Texels the layout would have taken at the requested texel size (may exceed
+    /// the budget; f64 as it may exceed every integer type).
+    pub requested_texels: f64,
+    /// Mapped objects whose texel was coarsened to fit the budget.
+    pub coarsened_objects: usize,
+    /// The largest texel side chosen (the requested size when nothing was
+    /// coarsened); per object see [`IlluminationMaps::object_texel_size`].
+    pub largest_texel: f32,
 }
 
 /// Illumination maps of the diffuse objects of a scene, in one texel storage `S`
@@ -181,6 +227,7 @@ pub struct IlluminationMaps<S, const OBJECTS: usize> {
     objects: FixedVec<ObjectMap, OBJECTS>,
     texel_size: f32,
     trim: f32,
+    budget: Option<usize>,
     used: usize,
     stats: MapStats,
 }
@@ -206,6 +253,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
             objects: FixedVec::new(),
             texel_size: positive(texel_size, "illumination map texel_size")?,
             trim: DEFAULT_TRIM,
+            budget: None,
             used: 0,
             stats: MapStats::default(),
         })
@@ -220,9 +268,31 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         Ok(self)
     }
 
-    /// Texel side, scene units.
+    /// At most `texels` texels in all (≥ 1, at most the storage's
+    /// [`capacity`](TexelStorage::capacity), checked at the build). Without it the
+    /// storage's [`default_budget`](TexelStorage::default_budget): the whole array of
+    /// a fixed storage, [`DEFAULT_HEAP_TEXELS`] of a `Vec`. A layout beyond the budget
+    /// is coarsened to fit it, object by object (see `fit_to_budget`).
+    pub fn with_texel_budget(mut self, texels: usize) -> Result<Self, Error> {
+        if texels == 0 {
+            return Err(Error::NotPositive {
+                what: "illumination map texel budget",
+                value: 0.0,
+            });
+        }
+        self.budget = Some(texels);
+        Ok(self)
+    }
+
+    /// The requested texel side, scene units.
     pub fn texel_size(&self) -> f32 {
         self.texel_size
+    }
+
+    /// The texel side chosen for scene object `object` by the last build (the
+    /// requested one unless the budget coarsened it); `None` when it is not mapped.
+    pub fn object_texel_size(&self, object: usize) -> Option<f32> {
+        self.slot(object).map(|m| m.texel)
     }
 
     /// What the last build did.
@@ -273,44 +343,9 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         scene: &Scene<O, L>,
         mut replay: impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
     ) -> Result<MapStats, Error> {
-        self.objects.clear();
-        self.used = 0;
-        self.stats = MapStats::default();
-        for (i, o) in scene.objects().iter().enumerate() {
-            if !o.material.stores_photons() {
-                continue;
-            }
-            let map = ObjectMap {
-                shape: o.shape,
-                object: i,
-                grids: [NO_GRID; 6],
-                charts: 0,
-                photons: 0,
-                lo: [f32::INFINITY; 2],
-                hi: [f32::NEG_INFINITY; 2],
-            };
-            self.objects.push(map).map_err(|_| Error::Capacity {
-                what: "illumination map objects",
-                requested: OBJECTS + 1,
-                capacity: OBJECTS,
-            })?;
-        }
-
+        self.reset(scene)?;
         // Pass 1: which objects receive photons, and the planes' photon rectangles.
-        replay(&mut |p: &Photon| {
-            if let Some((k, at)) = self.find(p.position(), None) {
-                if at.normal.dot(p.direction().get()) < 0.0 {
-                    let m = &mut self.objects[k];
-                    m.photons += 1;
-                    for a in 0..2 {
-                        let x = [at.u, at.v][a];
-                        m.lo[a] = m.lo[a].min(x);
-                        m.hi[a] = m.hi[a].max(x);
-                    }
-                }
-            }
-        });
-
+        replay(&mut |p: &Photon| self.survey(p));
         // Pass 2 per plane: trim the outliers off its rectangle.
         if self.trim > 0.0 {
             for k in 0..self.objects.len() {
@@ -322,55 +357,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
                 }
             }
         }
-
-        // Layout.
-        let s = self.texel_size;
-        let mut total: u64 = 0;
-        for m in self.objects.iter_mut() {
-            if m.photons == 0 {
-                continue;
-            }
-            let n = match m.shape {
-                Shape::Plane(_) => {
-                    let side = |a: usize| libm::ceilf((m.hi[a] - m.lo[a]) / s).max(1.0);
-                    let (w, h) = (side(0), side(1));
-                    if !(w <= u32::MAX as f32 && h <= u32::MAX as f32) {
-                        return Err(Error::Capacity {
-                            what: "illumination map texels",
-                            requested: usize::MAX,
-                            capacity: usize::MAX,
-                        });
-                    }
-                    m.grids[0] = Grid {
-                        offset: 0,
-                        w: w as u32,
-                        h: h as u32,
-                        u0: m.lo[0],
-                        du: s,
-                        v0: m.lo[1],
-                        dv: s,
-                        periodic_u: false,
-                        profile: Profile::Flat(1.0),
-                    };
-                    1
-                }
-                _ => bounded_grids(&m.shape, s, &mut m.grids).unwrap_or(0),
-            };
-            for g in &mut m.grids[..n] {
-                g.offset = total.min(u32::MAX as u64) as u32;
-                total += g.w as u64 * g.h as u64;
-            }
-            m.charts = n as u8;
-            self.stats.mapped_objects += 1;
-        }
-        if total > u32::MAX as u64 {
-            return Err(Error::Capacity {
-                what: "illumination map texels",
-                requested: total.min(usize::MAX as u64) as usize,
-                capacity: u32::MAX as usize,
-            });
-        }
-        let total = total as usize;
+        self.fit_to_budget()?;
+        let total = self.lay_out();
         self.texels.reserve(total)?;
         self.used = total;
         self.stats.texels = total;
@@ -395,6 +383,165 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         self.stats.dropped_photons = n_out;
         self.finish(unit);
         Ok(self.stats)
+    }
+
+    /// Forgets the last build and takes a slot for each object that stores photons.
+    fn reset<const O: usize, const L: usize>(&mut self, scene: &Scene<O, L>) -> Result<(), Error> {
+        self.objects.clear();
+        self.used = 0;
+        self.stats = MapStats::default();
+        for (i, o) in scene.objects().iter().enumerate() {
+            if !o.material.stores_photons() {
+                continue;
+            }
+            let map = ObjectMap {
+                shape: o.shape,
+                object: i,
+                grids: [NO_GRID; 6],
+                charts: 0,
+                photons: 0,
+                lo: [f32::INFINITY; 2],
+                hi: [f32::NEG_INFINITY; 2],
+                texel: self.texel_size,
+            };
+            self.objects.push(map).map_err(|_| Error::Capacity {
+                what: "illumination map objects",
+                requested: OBJECTS + 1,
+                capacity: OBJECTS,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Layout pass: counts a front-side photon on its object and widens a plane's
+    /// rectangle to it (a photon whose `(u, v)` overflows is left to be dropped).
+    fn survey(&mut self, p: &Photon) {
+        let Some((k, at)) = self.find(p.position(), None) else {
+            return;
+        };
+        if !(at.normal.dot(p.direction().get()) < 0.0) {
+            return;
+        }
+        let m = &mut self.objects[k];
+        if !(at.u.is_finite() && at.v.is_finite()) {
+            return;
+        }
+        m.photons += 1;
+        for (a, x) in [at.u, at.v].into_iter().enumerate() {
+            m.lo[a] = m.lo[a].min(x);
+            m.hi[a] = m.hi[a].max(x);
+        }
+    }
+
+    /// Chooses each mapped object's texel side so that the whole layout fits the
+    /// texel budget (see [`with_texel_budget`](Self::with_texel_budget)).
+    ///
+    /// At the requested size if it fits. Otherwise the budget is shared in proportion to
+    /// the photons each object received (texels beyond its photons only add noise),
+    /// objects visited by increasing texels-per-photon so that what a frugal object
+    /// leaves of its share goes to the others; an object over its share gets the
+    /// smallest texel (to 2⁻⁴⁰ relative, by bisection) whose layout fits it. Every
+    /// chart keeps at least one texel: a budget below that is an error.
+    fn fit_to_budget(&mut self) -> Result<(), Error> {
+        let budget = self.budget.unwrap_or_else(|| self.texels.default_budget());
+        if budget > self.texels.capacity() {
+            return Err(Error::Capacity {
+                what: "illumination map texel budget",
+                requested: budget,
+                capacity: self.texels.capacity(),
+            });
+        }
+        let s = self.texel_size;
+        let (mut need, mut least, mut photons) = (0.0f64, 0.0f64, 0.0f64);
+        let mut order: FixedVec<usize, OBJECTS> = FixedVec::new();
+        for (k, m) in self.objects.iter().enumerate() {
+            if m.photons == 0 {
+                continue;
+            }
+            if !(m.hi[0] - m.lo[0]).is_finite() || !(m.hi[1] - m.lo[1]).is_finite() {
+                return Err(Error::NotFinite {
+                    what: "illumination map: extent of the photons on a plane",
+                });
+            }
+            need += texels_at(m, s);
+            least += texels_at(m, coarsest(m));
+            photons += m.photons as f64;
+            let _ = order.push(k); // cannot overflow: one entry per slot
+        }
+        self.stats.texel_budget = budget;
+        self.stats.requested_texels = need;
+        self.stats.largest_texel = s;
+        if need <= budget as f64 {
+            return Ok(());
+        }
+        if least > budget as f64 {
+            return Err(Error::Capacity {
+                what: "illumination map texels (one a chart at the coarsest)",
+                requested: least as usize,
+                capacity: budget,
+            });
+        }
+        let objects = &mut self.objects;
+        let ratio = |m: &ObjectMap| texels_at(m, s) / m.photons as f64;
+        order.sort_unstable_by(|&a, &b| {
+            let (ra, rb) = (ratio(&objects[a]), ratio(&objects[b]));
+            ra.partial_cmp(&rb)
+                .unwrap_or(core::cmp::Ordering::Equal)
+                .then(a.cmp(&b))
+        });
+        let mut spare = budget as f64 - least;
+        for &k in order.iter() {
+            let m = &mut objects[k];
+            let (want, min) = (texels_at(m, s), texels_at(m, coarsest(m)));
+            let share = min + libm::floor(spare * m.photons as f64 / photons);
+            let used = if want <= share {
+                want
+            } else {
+                m.texel = coarsen(m, s, share);
+                self.stats.coarsened_objects += 1;
+                self.stats.largest_texel = self.stats.largest_texel.max(m.texel);
+                texels_at(m, m.texel)
+            };
+            spare -= used - min;
+            photons -= m.photons as f64;
+        }
+        Ok(())
+    }
+
+    /// Lays out the grids of every mapped object at its texel side, one after the
+    /// other in the shared array; returns the texels needed.
+    fn lay_out(&mut self) -> usize {
+        let mut total = 0usize;
+        for m in self.objects.iter_mut() {
+            if m.photons == 0 {
+                continue;
+            }
+            let s = m.texel;
+            let n = match m.shape {
+                Shape::Plane(_) => {
+                    m.grids[0] = Grid {
+                        offset: 0,
+                        w: plane_side(m, 0, s) as u32,
+                        h: plane_side(m, 1, s) as u32,
+                        u0: m.lo[0],
+                        du: s,
+                        v0: m.lo[1],
+                        dv: s,
+                        periodic_u: false,
+                        profile: Profile::Flat(1.0),
+                    };
+                    1
+                }
+                _ => bounded_grids(&m.shape, s, &mut m.grids).unwrap_or(0),
+            };
+            for g in &mut m.grids[..n] {
+                g.offset = total as u32;
+                total += g.len();
+            }
+            m.charts = n as u8;
+            self.stats.mapped_objects += 1;
+        }
+        total
     }
 
     /// The rectangle of plane `k` without the outlying `trim` of its photons beyond each
@@ -629,6 +776,58 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 /// The default plane trim: at most 0.5% of a plane's photons beyond each side of its
 /// rectangle (the faint, far halo of photons scattered off glass).
 pub const DEFAULT_TRIM: f32 = 0.005;
+
+/// Texels along axis `a` of a plane's rectangle at texel side `s` (at least one).
+fn plane_side(m: &ObjectMap, a: usize, s: f32) -> f32 {
+    libm::ceilf((m.hi[a] - m.lo[a]) / s).max(1.0)
+}
+
+/// Texels the charts of `m` take at texel side `s`, in f64 (a tiny texel over a far
+/// rectangle exceeds every integer type).
+fn texels_at(m: &ObjectMap, s: f32) -> f64 {
+    match m.shape {
+        Shape::Plane(_) => plane_side(m, 0, s) as f64 * plane_side(m, 1, s) as f64,
+        _ => {
+            let mut grids = [NO_GRID; 6];
+            let n = bounded_grids(&m.shape, s, &mut grids).unwrap_or(0);
+            grids[..n].iter().map(|g| g.len() as f64).sum()
+        }
+    }
+}
+
+/// A texel side at which every chart of `m` is a single texel: a plane rectangle's
+/// longer side; for a bounded shape π times its bounding diameter (1% over, for
+/// rounding), longer than any chart's extent (a sphere's equator, a box face's side,
+/// a cylinder's circumference or height).
+fn coarsest(m: &ObjectMap) -> f32 {
+    match m.shape {
+        Shape::Plane(_) => (m.hi[0] - m.lo[0])
+            .max(m.hi[1] - m.lo[1])
+            .max(f32::MIN_POSITIVE),
+        _ => m
+            .shape
+            .bounding_sphere()
+            .map_or(1.0, |b| 2.0 * PI * b.radius * 1.01),
+    }
+}
+
+/// The smallest texel side `≥ s` (to 2⁻⁴⁰ relative: a bisection on the logarithm)
+/// at which `m` takes at most `share` texels; `share` must hold its coarsest layout.
+fn coarsen(m: &ObjectMap, s: f32, share: f64) -> f32 {
+    let (mut lo, mut hi) = (s, coarsest(m).max(s));
+    for _ in 0..40 {
+        let mid = libm::sqrtf(lo) * libm::sqrtf(hi);
+        if !(mid > lo && mid < hi) {
+            break;
+        }
+        if texels_at(m, mid) <= share {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
 
 impl<S: TexelStorage, const OBJECTS: usize> CausticStore for IlluminationMaps<S, OBJECTS> {
     /// The bilinear reconstruction of the irradiance map at `x`.

@@ -14,16 +14,20 @@ mod estimate;
 mod illumination;
 pub mod kdtree;
 mod packed;
+mod splat;
 mod trace;
 
 pub use estimate::{ConeFilter, KdStore};
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
+#[cfg(feature = "std")]
+pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
 pub use kdtree::{
     balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
 };
 pub use packed::Photon;
+pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;
 
@@ -44,6 +48,27 @@ pub trait CausticStore {
 
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
+
+    /// As [`irradiance`](Self::irradiance), from photons within `radius` of `x` at most
+    /// (the footprint of the pixel that sees `x`): a store that gathers within a radius
+    /// bounds it by `radius` as well; others ignore it.
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
+        let _ = radius;
+        self.irradiance(x, n)
+    }
+
+    /// As [`classic`](Self::classic), from photons within `radius` of `x` at most.
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        to_eye: UnitVec3,
+        material: &Classic,
+        radius: f32,
+    ) -> Rgb {
+        let _ = radius;
+        self.classic(x, n, to_eye, material)
+    }
 }
 
 /// The store of a scene without caustics: no light.
@@ -70,6 +95,7 @@ pub struct PhotonSettings {
     full_sphere: bool,
     store_direct: bool,
     fixed_radius: bool,
+    splat: bool,
 }
 
 impl PhotonSettings {
@@ -94,6 +120,7 @@ impl PhotonSettings {
             full_sphere: false,
             store_direct: false,
             fixed_radius: false,
+            splat: true,
         })
     }
 
@@ -123,6 +150,19 @@ impl PhotonSettings {
     pub fn with_fixed_radius(mut self, fixed_radius: bool) -> Self {
         self.fixed_radius = fixed_radius;
         self
+    }
+
+    /// Whether the forward pass connects each landed photon to the eye (light tracing
+    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
+    /// backward pass gathers at every diffuse hit, as in the paper.
+    pub fn with_camera_splats(mut self, splat: bool) -> Self {
+        self.splat = splat;
+        self
+    }
+
+    /// `true` when landed photons are connected to the eye.
+    pub fn camera_splats(&self) -> bool {
+        self.splat
     }
 
     /// `true` when every photon within `max_radius` is gathered.
@@ -199,8 +239,13 @@ pub fn photons_needed<const O: usize, const L: usize>(
 /// `(scene, settings, seed, pass, l, i)`, so a pass can be split among threads in any
 /// way and still store the same photons.
 ///
-/// Photon `i` of light `l` in pass `pass` draws its direction from a Hammersley set
-/// shifted by `hash(seed, pass, l)` and its random choices from a PCG32 stream keyed by
+/// Each light's `n` photons are two independent halves — photon `i` belongs to half
+/// `h = i mod 2`, as photon `⌊i/2⌋` of a Hammersley set of `n_h` points (`n_0 = ⌈n/2⌉`,
+/// `n_1 = ⌊n/2⌋`) shifted by `hash(seed, pass, l, h)` (a Cranley–Patterson rotation:
+/// randomised quasi-Monte Carlo). Each half alone is an unbiased estimate; a photon
+/// carries `n_h/n` of its half's power, so the two add up to one estimate from `n`
+/// photons, and their difference measures that estimate's error (Owen 1997; see
+/// [`Splat::half`]). The random choices of photon `i` come from a PCG32 stream keyed by
 /// `hash(seed, pass, l, i)`. A scene with no mirror, glass or reflective/transparent
 /// classic object emits nothing, and so does a dark light.
 #[derive(Clone, Debug)]
@@ -209,9 +254,18 @@ pub struct Emitter<'a, const O: usize, const L: usize> {
     settings: PhotonSettings,
     seed: u64,
     pass: u32,
-    /// Per light: its emission plan and the point set's shift.
-    plans: heapless::Vec<(Emission<O>, (f32, f32)), L>,
+    /// Per light, per half: the emission plan, the point set's shift and the share
+    /// `n_h/n` of the light's photons.
+    plans: heapless::Vec<[Half<O>; 2], L>,
     unit: f32,
+}
+
+/// One half of a light's photons.
+#[derive(Clone, Debug)]
+struct Half<const O: usize> {
+    plan: Emission<O>,
+    shift: (f32, f32),
+    share: f32,
 }
 
 impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
@@ -227,13 +281,23 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             } else {
                 0
             };
-            let plan = Emission::<O>::plan(scene, light, count, full_sphere);
-            if count > 0 {
-                unit = unit.max(plan.nominal_power(light));
+            let half = |h: u32| {
+                let n = (count + 1 - h) / 2;
+                let key = hash(&[seed, pass as u64, l as u64, h as u64]);
+                Half {
+                    plan: Emission::<O>::plan(scene, light, n, full_sphere),
+                    shift: (unit_f32(key as u32), unit_f32((key >> 32) as u32)),
+                    share: n as f32 / count.max(1) as f32,
+                }
+            };
+            let halves = [half(0), half(1)];
+            for h in &halves {
+                if h.plan.count() > 0 {
+                    unit = unit.max(h.plan.nominal_power(light) * h.share);
+                }
             }
-            let key = hash(&[seed, pass as u64, l as u64]);
-            // Cannot overflow: one plan per light, at most L lights.
-            let _ = plans.push((plan, (unit_f32(key as u32), unit_f32((key >> 32) as u32))));
+            // Cannot overflow: one entry per light, at most L lights.
+            let _ = plans.push(halves);
         }
         if !(unit > 0.0 && unit.is_finite()) {
             plans.clear(); // nothing to emit
@@ -256,7 +320,9 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
 
     /// Photons light `l` emits (0 for a dark light or when nothing is emitted).
     pub fn count(&self, l: usize) -> u32 {
-        self.plans.get(l).map_or(0, |p| p.0.count())
+        self.plans
+            .get(l)
+            .map_or(0, |p| p[0].plan.count() + p[1].plan.count())
     }
 
     /// Photons emitted by all lights.
@@ -266,13 +332,21 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
 
     /// Traces photon `i` of light `l` (`i < count(l)`): where it is stored, if anywhere.
     pub fn photon(&self, l: usize, i: u32) -> Option<Photon> {
-        let (emission, shift) = self.plans.get(l)?;
+        self.land(l, i).map(|x| x.photon)
+    }
+
+    /// Traces photon `i` of light `l` (`i < count(l)`): the photon to store, if it
+    /// landed, and (when the settings ask for camera splats) its splat if the eye sees
+    /// where it landed.
+    pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
+        let half = &self.plans.get(l)?[(i & 1) as usize];
         let light = &self.scene.lights()[l];
-        let (dir, power) = emission.photon(light, i, *shift);
+        let (dir, power) = half.plan.photon(light, i >> 1, half.shift);
+        let power = power * half.share;
         let mut rng = Pcg32::new(hash(&[self.seed, self.pass as u64, l as u64, i as u64]));
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
-        let hit = trace::trace(
+        let landing = trace::trace(
             self.scene,
             ray,
             power,
@@ -280,8 +354,66 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             s.store_direct,
             &mut rng,
         )?;
-        Some(Photon::new(hit.pos, hit.dir, hit.power * (1.0 / self.unit)))
+        let material = &self.scene.objects()[landing.object].material;
+        let splat = if s.splat {
+            splat::connect(
+                self.scene,
+                &landing.hit,
+                material,
+                landing.dir,
+                landing.power,
+                i & 1 == 1,
+            )
+        } else {
+            None
+        };
+        Some(Landed {
+            photon: Photon::new(
+                landing.hit.point,
+                landing.dir,
+                landing.power * (1.0 / self.unit),
+            ),
+            splat,
+        })
     }
+}
+
+/// What one traced photon left: the photon to store, and its splat into the image when
+/// the eye sees where it landed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Landed {
+    /// The photon for the caustic store.
+    pub photon: Photon,
+    /// Its light-tracing contribution to the pixel it projects into.
+    pub splat: Option<Splat>,
+}
+
+/// The forward pass, photon by photon in emission order: `f` receives what each traced
+/// photon left (see [`Emitter::land`]) and may stop the pass with an error. Photon `i`
+/// of light `l` is the same whatever else is traced, so this is the one loop every
+/// forward pass runs (the desktop runs it on chunks of `(l, i)` on several threads).
+pub fn forward<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    mut f: impl FnMut(&Landed) -> Result<(), Error>,
+) -> Result<ForwardStats, Error> {
+    let emitter = Emitter::new(scene, settings, seed, pass);
+    let mut stats = ForwardStats {
+        emitted: emitter.emitted(),
+        stored: 0,
+        power_unit: emitter.power_unit(),
+    };
+    for l in 0..scene.lights().len() {
+        for i in 0..emitter.count(l) {
+            if let Some(x) = emitter.land(l, i) {
+                f(&x)?;
+                stats.stored += 1;
+            }
+        }
+    }
+    Ok(stats)
 }
 
 /// The forward pass of [`shoot`], handing each photon it would store to `f` instead of
@@ -294,33 +426,37 @@ pub fn for_each_photon<const O: usize, const L: usize>(
     pass: u32,
     mut f: impl FnMut(&Photon),
 ) -> ForwardStats {
-    let emitter = Emitter::new(scene, settings, seed, pass);
-    let mut stats = ForwardStats {
-        emitted: emitter.emitted(),
-        stored: 0,
-        power_unit: emitter.power_unit(),
-    };
-    for l in 0..scene.lights().len() {
-        for i in 0..emitter.count(l) {
-            if let Some(p) = emitter.photon(l, i) {
-                f(&p);
-                stats.stored += 1;
-            }
-        }
-    }
-    stats
+    let settings = settings.with_camera_splats(false);
+    forward(scene, &settings, seed, pass, |x| {
+        f(&x.photon);
+        Ok(())
+    })
+    .unwrap_or_default()
 }
 
 /// The forward pass: shoots `settings.count` photons from each light (see [`Emitter`])
 /// and stores those that land on a diffuse surface after a specular bounce, in
 /// emission order, into `out[..stored]` (not yet balanced). An error when `out` cannot
-/// hold `count × lights` photons.
+/// hold `count × lights` photons. Camera splats are not kept: see [`shoot_with_splats`].
 pub fn shoot<const O: usize, const L: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
     seed: u64,
     pass: u32,
     out: &mut [Photon],
+) -> Result<ForwardStats, Error> {
+    shoot_with_splats(scene, settings, seed, pass, out, &mut ())
+}
+
+/// As [`shoot`], also keeping the camera splats (see [`Splat`]) in `splats`, emptied
+/// first. An error when `splats` is full.
+pub fn shoot_with_splats<const O: usize, const L: usize>(
+    scene: &Scene<O, L>,
+    settings: &PhotonSettings,
+    seed: u64,
+    pass: u32,
+    out: &mut [Photon],
+    splats: &mut impl SplatStorage,
 ) -> Result<ForwardStats, Error> {
     let needed = photons_needed(scene, settings);
     if needed > out.len() {
@@ -330,12 +466,16 @@ pub fn shoot<const O: usize, const L: usize>(
             capacity: out.len(),
         });
     }
+    splats.clear_splats();
     let mut n = 0;
-    let stats = for_each_photon(scene, settings, seed, pass, |p| {
-        out[n] = *p;
+    forward(scene, settings, seed, pass, |x| {
+        out[n] = x.photon;
         n += 1;
-    });
-    Ok(stats)
+        match x.splat {
+            Some(s) => splats.push_splat(s),
+            None => Ok(()),
+        }
+    })
 }
 
 /// A photon map of fixed capacity `N`: the photons live in an array inside it, so its
@@ -363,26 +503,40 @@ impl<const N: usize> PhotonMap<N> {
         }
     }
 
-    /// Runs the forward pass into this map and balances it: see [`shoot`].
+    /// Runs the forward pass into this map and balances it: see [`shoot`]. The
+    /// camera's splats are dropped: see [`build_with_splats`](Self::build_with_splats).
     pub fn build<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
     ) -> Result<ForwardStats, Error> {
-        self.build_pass(scene, settings, seed, 0)
+        self.build_pass(scene, settings, seed, 0, &mut ())
     }
 
-    /// As [`build`](Self::build), for progressive pass number `pass`.
+    /// As [`build`](Self::build), keeping the camera splats in `splats` (for
+    /// [`Renderer::with_splats`](crate::render::Renderer::with_splats)).
+    pub fn build_with_splats<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+        splats: &mut impl SplatStorage,
+    ) -> Result<ForwardStats, Error> {
+        self.build_pass(scene, settings, seed, 0, splats)
+    }
+
+    /// As [`build_with_splats`](Self::build_with_splats), for progressive pass `pass`.
     pub fn build_pass<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
         seed: u64,
         pass: u32,
+        splats: &mut impl SplatStorage,
     ) -> Result<ForwardStats, Error> {
         self.len = 0;
-        let stats = shoot(scene, settings, seed, pass, &mut self.photons)?;
+        let stats = shoot_with_splats(scene, settings, seed, pass, &mut self.photons, splats)?;
         self.len = stats.stored;
         self.unit = stats.power_unit;
         balance(&mut self.photons[..self.len]);

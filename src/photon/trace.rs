@@ -1,16 +1,21 @@
 //! Tracing one photon through mirrors and glass to where it lands.
 
-use crate::geometry::Ray;
+use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Material};
-use crate::math::{reflect, Rgb, UnitVec3, Vec3};
+use crate::math::{reflect, Rgb, UnitVec3};
 use crate::sampling::Pcg32;
 use crate::scene::Scene;
 
 /// Where a photon came to rest on a surface with a diffuse part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Landing {
-    pub pos: Vec3,
+    /// The surface hit (point, normal, error bound).
+    pub hit: Hit,
+    /// Index of the object it landed on.
+    pub object: usize,
+    /// Direction of travel.
     pub dir: UnitVec3,
+    /// Power, W.
     pub power: Rgb,
 }
 
@@ -41,7 +46,8 @@ pub(crate) fn trace<const O: usize, const L: usize>(
         let may_store = (bounces >= 1 || store_direct) && front && material.stores_photons();
         if may_store {
             return Some(Landing {
-                pos: hit.point,
+                hit,
+                object: index,
                 dir: ray.dir,
                 power,
             });

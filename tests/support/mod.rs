@@ -14,11 +14,11 @@ use caustic::render::Renderer;
 pub fn fig6_rows(mut sink: impl FnMut(u32, &[Rgb])) -> ForwardStats {
     let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(FIG6.width, FIG6.height).unwrap();
     let settings = FIG6.settings().unwrap();
-    let mut map: Box<DeviceMap<{ FIG6.stored }>> = Box::default();
+    let mut map: Box<DeviceMap<{ FIG6.stored }, { FIG6.splats }>> = Box::default();
     let forward = map.build(&scene, &settings, FIG6.seed).unwrap();
     let store = map.store::<{ FIG6.k }>(&settings).unwrap();
     let renderer: Renderer<_, FIG6_OBJECTS, FIG6_LIGHTS, { FIG6.depth }> =
-        Renderer::new(&scene, &store, settings.max_depth()).unwrap();
+        map.with_splats(Renderer::new(&scene, &store, settings.max_depth()).unwrap());
     let mut row = [Rgb::ZERO; FIG6.width as usize];
     renderer
         .rows(&mut row, |y, pixels| {

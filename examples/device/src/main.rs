@@ -4,7 +4,7 @@
 //! trap differ (`arm.rs`, `riscv.rs`, `semihosting.rs`).
 //!
 //! Every capacity is `caustic::budget::FIG6`: the forward pass fills a
-//! `DeviceMap<{ FIG6.stored }>` that lives in a `static` (in `.bss`, not on the
+//! `DeviceMap<{ FIG6.stored }, { FIG6.splats }>` that lives in a `static` (in `.bss`, not on the
 //! stack); the backward pass renders one row at a time into a 160-pixel buffer (also
 //! static: the stack holds only the path stack, the gather and the call frames), and
 //! each row goes through `caustic::raster::DisplaySink` onto a
@@ -51,7 +51,7 @@ const WIDTH: usize = FIG6.width as usize;
 /// What the render keeps outside the stack: the photon map (in `.bss`, counted by
 /// the linker), the row of linear radiance, and the output path.
 struct Statics {
-    map: DeviceMap<{ FIG6.stored }>,
+    map: DeviceMap<{ FIG6.stored }, { FIG6.splats }>,
     row: [Rgb; WIDTH],
     path: [u8; 256],
 }
@@ -151,17 +151,20 @@ pub fn run() -> ! {
     caustic_mark_photons_end();
     let forward = forward.unwrap_or_else(|_| fail("forward pass (more photons than FIG6.stored?)"));
     hprintln!(
-        "photons: {} emitted, {} stored (capacity {})",
+        "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
         forward.emitted,
         forward.stored,
-        FIG6.stored
+        FIG6.stored,
+        map.splats().len(),
+        FIG6.splats
     );
 
     let store = map
         .store::<{ FIG6.k }>(&settings)
         .unwrap_or_else(|_| fail("store"));
-    let renderer: Renderer<_, FIG6_OBJECTS, FIG6_LIGHTS, { FIG6.depth }> =
-        Renderer::new(&scene, &store, settings.max_depth()).unwrap_or_else(|_| fail("renderer"));
+    let renderer: Renderer<_, FIG6_OBJECTS, FIG6_LIGHTS, { FIG6.depth }> = map.with_splats(
+        Renderer::new(&scene, &store, settings.max_depth()).unwrap_or_else(|_| fail("renderer")),
+    );
     let mut file = HostFile::create(path).unwrap_or_else(|e| fail(e));
     let mut stream =
         Rgb565Stream::<_, WIDTH>::new(FIG6.width, FIG6.height, |b: &[u8]| file.write(b))

@@ -40,7 +40,7 @@ const WIDTH: usize = FIG6.width as usize;
 
 /// The photon map and the row: statics, not on the stack.
 struct Statics {
-    map: DeviceMap<{ FIG6.stored }>,
+    map: DeviceMap<{ FIG6.stored }, { FIG6.splats }>,
     row: [Rgb; WIDTH],
 }
 
@@ -138,6 +138,7 @@ fn main() -> ! {
     ) else {
         fail(&mut led, &mut timer)
     };
+    let renderer = map.with_splats(renderer);
     let drawn = {
         let mut sink = DisplaySink::new(&mut display, ToneMap::default(), Dither::Off);
         renderer.rows(row, |y, pixels| sink.draw_row(y, pixels))

@@ -1,0 +1,217 @@
+//! How a pixel's area is sampled, and rows of pixels.
+//!
+//! A pixel's value is the average radiance over its area (a box filter). The default
+//! [`Sampling::Adaptive`] follows Whitted (1980): trace the pixel's four corners and
+//! average them where they agree; where they do not (different objects along the
+//! paths, a light visible from one and not another, or a luminance contrast
+//! `(max − min)/(max + min)` above [`CONTRAST`], Mitchell 1987), average an `n × n`
+//! grid of sub-pixel rays instead. Corners are shared along a row, so a smooth region
+//! costs about two rays a pixel; shadow edges, silhouettes and whatever is seen through
+//! glass get `n²`.
+
+use super::{PixelEstimate, RayCount, Renderer, RowsError, Sample};
+use crate::error::Error;
+use crate::math::Rgb;
+use crate::photon::{add_to_row, CausticStore};
+
+/// How a pixel's area is sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// One ray through the pixel centre (the paper; a point estimate of the pixel).
+    Centre,
+    /// `n × n` rays through the centres of an `n × n` grid of sub-pixels, averaged.
+    Grid(u32),
+    /// The four corners, averaged where they agree; an `n × n` grid where they do not.
+    Adaptive(u32),
+}
+
+/// The corner contrast above which [`Sampling::Adaptive`] supersamples a pixel.
+pub const CONTRAST: f32 = 0.04;
+
+/// The default sub-pixel grid side of [`Sampling::Adaptive`].
+pub const REFINE: u32 = 4;
+
+impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
+    Renderer<'_, S, O, L, DEPTH>
+{
+    /// Pixel `(x, y)` as the mean of an `n × n` grid of sub-pixel rays. Its sampling
+    /// error is estimated from the grid's two checkerboard halves `a`, `b` as
+    /// `((m_a − m_b)/2)²` per channel: the batch-means estimate for two half-grids.
+    fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> PixelEstimate {
+        let step = 1.0 / n as f32;
+        let camera = self.scene.camera();
+        let mut half = [(Rgb::ZERO, Rgb::ZERO, 0u32); 2];
+        for sy in 0..n {
+            for sx in 0..n {
+                let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
+                let s = self.sample(camera.ray_at(x, y, fx, fy), count);
+                let h = &mut half[((sx + sy) & 1) as usize];
+                h.0 += s.radiance;
+                h.1 += s.caustic;
+                h.2 += 1;
+            }
+        }
+        let inv = 1.0 / (n * n) as f32;
+        let sampling2 = if half[1].2 > 0 {
+            let d =
+                (half[0].0 * (1.0 / half[0].2 as f32) - half[1].0 * (1.0 / half[1].2 as f32)) * 0.5;
+            d * d
+        } else {
+            Rgb::ZERO
+        };
+        PixelEstimate {
+            radiance: (half[0].0 + half[1].0) * inv,
+            caustic: (half[0].1 + half[1].1) * inv,
+            split: Rgb::ZERO,
+            sampling2,
+        }
+    }
+
+    /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
+    #[inline]
+    fn corner(&self, cx: u32, cy: u32, count: &mut RayCount) -> Sample {
+        self.sample(self.scene.camera().ray_at(cx, cy, 0.0, 0.0), count)
+    }
+
+    /// Renders row `y` (0 = top) pixel by pixel, handing each estimate to `put`.
+    fn row_with(
+        &self,
+        y: u32,
+        width: usize,
+        mut put: impl FnMut(usize, PixelEstimate),
+    ) -> RayCount {
+        let mut count = RayCount::default();
+        let camera = self.scene.camera();
+        let one = |s: Sample| PixelEstimate {
+            radiance: s.radiance,
+            caustic: s.caustic,
+            ..PixelEstimate::default()
+        };
+        match self.sampling {
+            Sampling::Centre => {
+                for x in 0..width {
+                    put(x, one(self.sample(camera.ray(x as u32, y), &mut count)));
+                }
+            }
+            Sampling::Grid(n) => {
+                for x in 0..width {
+                    put(x, self.grid(x as u32, y, n, &mut count));
+                }
+            }
+            Sampling::Adaptive(n) => {
+                // Corners shared along the row: the left pair comes from the pixel before.
+                let mut top = self.corner(0, y, &mut count);
+                let mut bottom = self.corner(0, y + 1, &mut count);
+                for x in 0..width {
+                    let right_top = self.corner(x as u32 + 1, y, &mut count);
+                    let right_bottom = self.corner(x as u32 + 1, y + 1, &mut count);
+                    let c = [top, right_top, bottom, right_bottom];
+                    put(
+                        x,
+                        if agree(&c) {
+                            let mean = |f: fn(&Sample) -> Rgb| {
+                                (f(&c[0]) + f(&c[1]) + f(&c[2]) + f(&c[3])) * 0.25
+                            };
+                            PixelEstimate {
+                                radiance: mean(|s| s.radiance),
+                                caustic: mean(|s| s.caustic),
+                                ..PixelEstimate::default()
+                            }
+                        } else {
+                            count.refined += 1;
+                            self.grid(x as u32, y, n, &mut count)
+                        },
+                    );
+                    (top, bottom) = (right_top, right_bottom);
+                }
+            }
+        }
+        count
+    }
+
+    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width), without the
+    /// splats (see [`with_splats`](Self::with_splats)).
+    pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
+        self.row_with(y, row.len(), |x, p| row[x] = p.radiance)
+    }
+
+    /// As [`row`](Self::row), with each pixel's caustic part and error estimate.
+    pub fn row_estimates(&self, y: u32, row: &mut [PixelEstimate]) -> RayCount {
+        self.row_with(y, row.len(), |x, p| row[x] = p)
+    }
+
+    /// The row buffer cut to the image width; an error when it is shorter.
+    fn fit<'b, T, E>(&self, row: &'b mut [T]) -> Result<&'b mut [T], RowsError<E>> {
+        let width = self.scene.camera().width() as usize;
+        let len = row.len();
+        row.get_mut(..width)
+            .ok_or(RowsError::Render(Error::Capacity {
+                what: "row buffer (pixels of one image row)",
+                requested: width,
+                capacity: len,
+            }))
+    }
+
+    /// Renders every row, top to bottom, into the caller's one-row buffer, adds the
+    /// splats that fall in it, and hands each to `sink` before the next is computed: no
+    /// frame buffer. The sink receives exactly `width` pixels (a longer buffer's tail is
+    /// left alone).
+    ///
+    /// An error, before anything is rendered, when `row` is shorter than the image width
+    /// ([`RowsError::Render`] with [`Error::Capacity`]); otherwise stops at the sink's
+    /// first error and returns it ([`RowsError::Sink`]).
+    pub fn rows<E>(
+        &self,
+        row: &mut [Rgb],
+        mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
+    ) -> Result<RayCount, RowsError<E>> {
+        let row = self.fit(row)?;
+        let mut count = RayCount::default();
+        for y in 0..self.scene.camera().height() {
+            count += self.row(y, row);
+            if let Some(splats) = self.splats {
+                add_to_row(splats, y, row);
+            }
+            sink(y, row).map_err(RowsError::Sink)?;
+        }
+        Ok(count)
+    }
+
+    /// As [`rows`](Self::rows), with each pixel's caustic part and error estimate (the
+    /// same radiance, bit for bit).
+    pub fn rows_estimates<E>(
+        &self,
+        row: &mut [PixelEstimate],
+        mut sink: impl FnMut(u32, &[PixelEstimate]) -> Result<(), E>,
+    ) -> Result<RayCount, RowsError<E>> {
+        let row = self.fit(row)?;
+        let mut count = RayCount::default();
+        for y in 0..self.scene.camera().height() {
+            count += self.row_estimates(y, row);
+            if let Some(splats) = self.splats {
+                add_to_row(splats, y, row);
+            }
+            sink(y, row).map_err(RowsError::Sink)?;
+        }
+        Ok(count)
+    }
+}
+
+/// `true` when four corner samples saw the same things and their luminances are within
+/// [`CONTRAST`] (Mitchell 1987's contrast, on luminance).
+fn agree(c: &[Sample; 4]) -> bool {
+    let s = c[0].signature;
+    if c.iter().any(|x| x.signature != s) {
+        return false;
+    }
+    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+    for x in c {
+        let l = x.radiance.luminance();
+        if l < lo {
+            lo = l;
+        }
+        hi = crate::math::max(hi, l);
+    }
+    // `!(a > b)` so that NaN never counts as agreement.
+    !(hi - lo > CONTRAST * (hi + lo))
+}
