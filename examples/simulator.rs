@@ -334,7 +334,8 @@ where
         .into());
     }
     let mut photons = vec![Photon::ZERO; needed];
-    let forward = photon::shoot(scene, settings, seed, 0, &mut photons)?;
+    let mut splats = Vec::new();
+    let forward = photon::shoot_with_splats(scene, settings, seed, 0, &mut photons, &mut splats)?;
     photons.truncate(forward.stored);
     photon::balance(&mut photons);
     let store = photon::store_over::<K>(
@@ -344,6 +345,13 @@ where
     )?;
     let renderer: Renderer<'_, _, O, L, DEPTH> =
         Renderer::new(scene, &store, settings.max_depth())?;
+    // As the device (`budget::DeviceMap::with_splats`): caustics seen directly are
+    // light-traced when the settings splat.
+    let renderer = if settings.camera_splats() {
+        renderer.with_splats(&splats)
+    } else {
+        renderer
+    };
 
     let mut row = vec![Rgb::ZERO; scene.camera().width() as usize];
     let count = renderer

@@ -57,3 +57,43 @@ pub fn fig6<const O: usize, const L: usize>(width: u32, height: u32) -> Result<S
     )?;
     Ok(scene)
 }
+
+/// A physical scene for devices: a glass sphere (index 1.5, Beer absorption
+/// σ = (0.05, 0.12, 0.3) per unit length: a faint amber tint through its 2-unit
+/// diameter) resting on a grey diffuse floor (albedo 0.8), beside a tilted mirror
+/// (reflectance 0.9, a 2.4 × 1.6 × 0.05 slab) that throws a second, reflected patch of
+/// light, lit by one point light (60 W/sr) and seen from (0, 4, 7) as in
+/// `scenes/glass_sphere.json`. Rendered at `width × height`. Its device budget is
+/// [`crate::budget::GLASS`].
+pub fn glass<const O: usize, const L: usize>(
+    width: u32,
+    height: u32,
+) -> Result<Scene<O, L>, Error> {
+    let camera = Camera::new(
+        Vec3::new(0.0, 4.0, 7.0),
+        Vec3::new(0.0, 0.6, 0.0),
+        Vec3::Y,
+        40.0,
+        width,
+        height,
+    )?;
+    let mut scene = Scene::new(camera);
+    scene.add_light(PointLight::new(
+        Vec3::new(-3.0, 6.0, -2.0),
+        Rgb::splat(60.0),
+    )?)?;
+    let floor = Material::diffuse(Rgb::splat(0.8))?;
+    let glass = Material::dielectric(1.5, Rgb::new(0.05, 0.12, 0.3))?;
+    let mirror = Material::mirror(Rgb::splat(0.9))?;
+    scene.add(Shape::plane(Vec3::ZERO, Vec3::Y)?, floor)?;
+    scene.add(Shape::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0)?, glass)?;
+    scene.add(
+        Shape::cuboid(
+            Vec3::new(2.2, 0.8, -1.5),
+            Vec3::new(2.4, 1.6, 0.05),
+            Vec3::new(0.0, -35.0, 0.0),
+        )?,
+        mirror,
+    )?;
+    Ok(scene)
+}

@@ -4,9 +4,10 @@
 //!
 //! The scene, budget (`caustic::budget::FIG6`), tone map and dither are the
 //! firmware's, and so is the display: the library's `Rgb565Stream`. `run.sh` runs the
-//! firmware under QEMU on four instruction sets, then this test with
-//! - `CAUSTIC_DEVICE_RGB565`: a device's file (little-endian RGB565, row-major);
-//! - `CAUSTIC_DEVICE_FNV1A`: the hash from the firmware's `PASS` line.
+//! firmware under QEMU on four instruction sets, then this test with, per scene
+//! (`FIG6`, `GLASS`),
+//! - `CAUSTIC_DEVICE_<SCENE>_RGB565`: a device's file (little-endian RGB565, row-major);
+//! - `CAUSTIC_DEVICE_<SCENE>_FNV1A`: the hash from the firmware's `PASS` line.
 //!
 //! The committed hash is what every firmware printed (`PASS fnv1a=…`) when it was
 //! last changed: `cargo test` alone therefore checks the host against the device.
@@ -16,7 +17,7 @@ mod support;
 
 use std::mem::size_of;
 
-use caustic::budget::{DeviceMap, DeviceMemory, FIG6, FIG6_LIGHTS, FIG6_OBJECTS};
+use caustic::budget::{DeviceMap, DeviceMemory, FIG6, FIG6_LIGHTS, FIG6_OBJECTS, GLASS};
 use caustic::math::Rgb;
 use caustic::photon::{KdStore, Photon};
 use caustic::raster::Fnv1a;
@@ -25,63 +26,88 @@ use caustic::scene::Scene;
 /// FNV-1a of Fig. 6's RGB565 bytes as the four firmwares (Cortex-M4F, M3, M33,
 /// RV32IMAC) streamed them under QEMU (tools/device/run.sh).
 const FIG6_FNV1A: u32 = 0xc8f3_1be2;
+/// FNV-1a of the glass scene's bytes (`demo::glass`, `budget::GLASS`), as the four
+/// firmwares built with `--features glass` streamed them.
+const GLASS_FNV1A: u32 = 0x3d6c_a526;
 
-#[test]
-fn device_image_is_the_host_image_bit_for_bit() {
-    let (bytes, hash, forward, rows) = support::fig6_stream();
+/// Checks a host stream of scene `tag` (`FIG6`, `GLASS`): rows in order, the
+/// committed hash, and, when run.sh hands them over, the device's bytes
+/// (`CAUSTIC_DEVICE_<TAG>_RGB565`) and hash (`CAUSTIC_DEVICE_<TAG>_FNV1A`).
+fn check_against_the_device(tag: &str, s: &support::Streamed, height: u32, committed: u32) {
     assert_eq!(
-        rows,
-        (0..FIG6.height).collect::<Vec<_>>(),
+        s.rows,
+        (0..height).collect::<Vec<_>>(),
         "rows top to bottom, once each"
     );
-    assert_eq!(bytes.len(), 2 * (FIG6.width * FIG6.height) as usize);
-    assert_eq!(hash, Fnv1a::of(&bytes));
-    assert!(forward.stored > 0, "the cube makes caustic photons");
+    assert_eq!(s.hash, Fnv1a::of(&s.bytes));
+    assert!(s.forward.stored > 0, "caustic photons land");
     println!(
-        "host: {}x{} RGB565, {} photons stored of {} emitted, fnv1a=0x{hash:08x}",
-        FIG6.width, FIG6.height, forward.stored, forward.emitted
+        "host {tag}: {} bytes RGB565, {} photons stored of {} emitted, fnv1a=0x{:08x}",
+        s.bytes.len(),
+        s.forward.stored,
+        s.forward.emitted,
+        s.hash
     );
     assert_eq!(
-        hash, FIG6_FNV1A,
-        "the host render is not the committed device image (if the renderer changed on \
-         purpose, run tools/device/run.sh and commit the hash every firmware prints)"
+        s.hash, committed,
+        "{tag}: the host render is not the committed device image (if the renderer changed \
+         on purpose, run tools/device/run.sh and commit the hash every firmware prints)"
     );
-
-    if let Ok(expected) = std::env::var("CAUSTIC_DEVICE_FNV1A") {
+    if let Ok(expected) = std::env::var(format!("CAUSTIC_DEVICE_{tag}_FNV1A")) {
         let expected = u32::from_str_radix(expected.trim().trim_start_matches("0x"), 16)
-            .expect("CAUSTIC_DEVICE_FNV1A is a hex u32");
+            .expect("the device hash is a hex u32");
         assert_eq!(
-            hash, expected,
-            "the host's hash against the firmware's PASS line"
+            s.hash, expected,
+            "{tag}: the host's hash against the firmware's PASS line"
         );
     }
-    let Some(path) = std::env::var_os("CAUSTIC_DEVICE_RGB565") else {
-        println!("CAUSTIC_DEVICE_RGB565 not set: compared with the committed hash only");
+    let Some(path) = std::env::var_os(format!("CAUSTIC_DEVICE_{tag}_RGB565")) else {
+        println!("{tag}: no device file given: compared with the committed hash only");
         return;
     };
     let device =
         std::fs::read(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.to_string_lossy()));
-    assert_eq!(device.len(), bytes.len(), "device file length");
-    let differing: Vec<usize> = (0..bytes.len() / 2)
-        .filter(|&i| device[2 * i..2 * i + 2] != bytes[2 * i..2 * i + 2])
+    assert_eq!(device.len(), s.bytes.len(), "{tag}: device file length");
+    let width = s.bytes.len() / 2 / height as usize;
+    let differing: Vec<usize> = (0..s.bytes.len() / 2)
+        .filter(|&i| device[2 * i..2 * i + 2] != s.bytes[2 * i..2 * i + 2])
         .collect();
     if let Some(&i) = differing.first() {
         let px = |b: &[u8]| u16::from_le_bytes([b[2 * i], b[2 * i + 1]]);
         panic!(
-            "{} of {} pixels differ; first at ({}, {}): device {:#06x}, host {:#06x}",
+            "{tag}: {} of {} pixels differ; first at ({}, {}): device {:#06x}, host {:#06x}",
             differing.len(),
-            bytes.len() / 2,
-            i % FIG6.width as usize,
-            i / FIG6.width as usize,
+            s.bytes.len() / 2,
+            i % width,
+            i / width,
             px(&device),
-            px(&bytes),
+            px(&s.bytes),
         );
     }
     println!(
-        "device file {} is bit-identical to the host render ({} bytes)",
+        "{tag}: device file {} is bit-identical to the host render ({} bytes)",
         path.to_string_lossy(),
         device.len()
     );
+}
+
+#[test]
+fn device_image_is_the_host_image_bit_for_bit() {
+    check_against_the_device("FIG6", &support::fig6_stream(), FIG6.height, FIG6_FNV1A);
+}
+
+/// The physical scene: a dielectric sphere (Fresnel, Beer absorption), a mirror and a
+/// diffuse floor, with the desktop's default estimator (light-traced caustics where
+/// the eye sees them, gathers behind the glass).
+#[test]
+fn glass_scene_on_the_device_is_the_host_image_bit_for_bit() {
+    let s = support::glass_stream();
+    check_against_the_device("GLASS", &s, GLASS.height, GLASS_FNV1A);
+    // Not a blank frame: the floor, the sphere, its caustic and the mirror.
+    let mut colours: Vec<&[u8]> = s.bytes.chunks(2).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 100, "{} colours", colours.len());
 }
 
 #[test]

@@ -109,7 +109,11 @@ fn defaults_are_the_device() {
 #[test]
 fn simulator_shows_exactly_what_the_device_streams() {
     // The stream refuses pixels out of order: completing it means one pass, in order.
-    let (device, hash, _, _) = support::fig6_stream();
+    let support::Streamed {
+        bytes: device,
+        hash,
+        ..
+    } = support::fig6_stream();
     println!("device stream fnv1a=0x{hash:08x}");
 
     let display = simulate::<Rgb565>(&Options::default());

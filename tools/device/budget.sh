@@ -32,7 +32,7 @@ vt=$(section .vector_table); text=$(section .text); rodata=$(section .rodata)
 data=$(section .data); bss=$(section .bss); uninit=$(section .uninit)
 flash=$((vt + text + rodata + data))
 ram=$((data + bss + uninit))
-map_hex=$("$nm" -S -C "$elf" | awk '$4 ~ /caustic_device::MAP(::h[0-9a-f]+)?$/ { print $2 }')
+map_hex=$("$nm" -S -C "$elf" | awk '$4 ~ /caustic_device::STATICS(::h[0-9a-f]+)?$/ { print $2 }')
 map=$(( 16#${map_hex:-0} ))
 stack=$(sed -n 's/^stack high-water: \([0-9]*\) bytes.*/\1/p' "$qemu_log")
 [[ -n "$stack" ]] || { echo "budget.sh: no 'stack high-water' line in $qemu_log" >&2; exit 1; }
@@ -48,7 +48,7 @@ printf '%-44s %12s %10s  %-8s %s\n' "what" "measured" "" "bar" ""
 printf '%-44s %12d %10s  %-8s %s\n' "flash (.vector_table+.text+.rodata+.data)" "$flash" "$(kib "$flash")" "48 KiB" "$(check "$flash" 49152)"
 printf '%-44s %12s\n' "  .vector_table / .text / .rodata" "$vt / $text / $rodata"
 printf '%-44s %12d %10s  %-8s %s\n' "static RAM (.data+.bss+.uninit)" "$ram" "$(kib "$ram")" "64 KiB" "$(check "$ram" 65536)"
-printf '%-44s %12d %10s\n' "  of which the photon map (static)" "$map" "$(kib "$map")"
+printf '%-44s %12d %10s\n' "  of which map, splats, row, path (statics)" "$map" "$(kib "$map")"
 printf '%-44s %12d %10s  %-8s %s\n' "stack high-water (measured)" "$stack" "$(kib "$stack")" "4 KiB" "$(check "$stack" 4096)"
 printf '%-44s %12d\n' "instructions, forward pass" "$insns_photons"
 printf '%-44s %12d\n' "instructions, render (160x120)" "$insns_render"

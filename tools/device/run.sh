@@ -7,20 +7,21 @@
 #       cortex-m3   thumbv7m-none-eabi         qemu-system-arm     -machine mps2-an385 (soft float)
 #       cortex-m33  thumbv8m.main-none-eabihf  qemu-system-arm     -machine mps2-an505 (Armv8-M)
 #       rv32imac    riscv32imac-unknown-none-elf qemu-system-riscv32 -machine virt  (soft float)
+#     twice: for Fig. 6, and with --features glass for the physical scene (NAME-glass);
 #     and the QEMU plugin insn_plugin.so (counts instructions; any guest architecture);
-#  3. runs each under QEMU (semihosting, 300 s time-out): it renders Fig. 6 at 160x120
+#  3. runs each under QEMU (semihosting, 300 s time-out): it renders its scene at 160x120
 #     row by row into OUT/NAME.rgb565 (RGB565, little-endian) and prints a PASS line with
 #     the FNV-1a of those bytes;
-#  4. converts the Cortex-M4F image to OUT/fig6.png;
-#  5. runs the host test tests/device.rs against the first firmware's bytes and hash
-#     (host == device bit for bit, and both == the committed hash); the other firmwares'
-#     files must equal the first byte for byte;
+#  4. converts the Cortex-M4F images to OUT/fig6.png and OUT/glass.png;
+#  5. runs the host test tests/device.rs against the Cortex-M4F firmwares' bytes and
+#     hashes (host == device bit for bit, and both == the committed hashes); the other
+#     firmwares' files must equal those byte for byte;
 #  6. prints each firmware's budget (budget.sh) and the Cortex-M4F instruction profile;
 #  7. ends with one JSON line per firmware:
 #     {"firmware","target","flash_bytes","static_ram_bytes","stack_bytes","photon_bytes",
 #      "forward_instructions","render_instructions","bit_identical"}.
 #
-#   tools/device/run.sh [--update-png] [--skip-targets] [--only NAME]
+#   tools/device/run.sh [--update-png] [--skip-targets] [--only NAME]   (NAME e.g. cortex-m4f-glass)
 #
 # OUT is examples/device/target/run (git-ignored); CAUSTIC_DEVICE_OUT overrides it
 # (no spaces or commas: the path travels in QEMU's -semihosting-config). Exits non-zero
@@ -46,13 +47,21 @@ case "$out" in *[[:space:],]*) echo "run.sh: output path must not contain spaces
 start=$(date +%s)
 step() { echo; echo "==> $*"; }
 
-# name target qemu machine-and-cpu flags
-firmwares=(
+# name target qemu machine-and-cpu-flags scene (fig6 | glass: cargo feature)
+boards=(
     "cortex-m4f|thumbv7em-none-eabihf|qemu-system-arm|-machine mps2-an386 -cpu cortex-m4"
     "cortex-m3|thumbv7m-none-eabi|qemu-system-arm|-machine mps2-an385 -cpu cortex-m3"
     "cortex-m33|thumbv8m.main-none-eabihf|qemu-system-arm|-machine mps2-an505 -cpu cortex-m33"
     "rv32imac|riscv32imac-unknown-none-elf|qemu-system-riscv32|-machine virt -bios none"
 )
+firmwares=()
+for scene in fig6 glass; do
+    for b in "${boards[@]}"; do
+        name="${b%%|*}"
+        [[ $scene == glass ]] && name="$name-glass"
+        firmwares+=("$name|${b#*|}|$scene")
+    done
+done
 if [[ -n "$only" ]]; then
     keep=()
     for f in "${firmwares[@]}"; do [[ "${f%%|*}" == "$only" ]] && keep+=("$f"); done
@@ -74,7 +83,7 @@ if (( ${#need_apt[@]} )); then
 fi
 installed="$(rustup target list --installed 2>/dev/null)"
 for f in "${firmwares[@]}"; do
-    IFS='|' read -r _ target _ _ <<<"$f"
+    IFS='|' read -r _ target _ _ _ <<<"$f"
     grep -qx "$target" <<<"$installed" || rustup target add "$target"
 done
 host="$(rustc -vV | sed -n 's/^host: //p')"
@@ -96,10 +105,14 @@ fi
 
 # --- 2-3. each firmware: build, run ------------------------------------------------------
 for f in "${firmwares[@]}"; do
-    IFS='|' read -r name target qemu machine <<<"$f"
-    step "$name: building for $target (release)"
-    (cd "$fw" && CARGO_TARGET_DIR="$fw/target" cargo build --release --target "$target")
-    elf="$fw/target/$target/release/caustic-device"
+    IFS='|' read -r name target qemu machine scene <<<"$f"
+    step "$name: building for $target (release, scene $scene)"
+    features=()
+    [[ $scene == glass ]] && features=(--features glass)
+    (cd "$fw" && CARGO_TARGET_DIR="$fw/target" cargo build --release --target "$target" "${features[@]}")
+    # The next build of this target overwrites the ELF: keep this one under its name.
+    elf="$out/$name.elf"
+    cp "$fw/target/$target/release/caustic-device" "$elf"
     step "$name: running under $qemu $machine"
     marks=$("$bin/llvm-nm" "$elf" | awk '/ caustic_mark_/ { printf ",mark=0x%s", $1 }')
     [[ $(tr -cd ',' <<<"$marks" | wc -c) == 4 ]] || { echo "run.sh: phase marks not found in $elf" >&2; exit 1; }
@@ -120,30 +133,49 @@ for f in "${firmwares[@]}"; do
 done
 
 # --- 4. PNG ----------------------------------------------------------------------------
-first="${firmwares[0]%%|*}"
-python3 "$root/tools/device/rgb565_to_png.py" "$out/$first.rgb565" "$out/fig6.png" 160 120
-echo "image: $out/fig6.png"
-if (( update_png )); then
-    cp "$out/fig6.png" "$fw/fig6-qemu.png"
-    echo "updated examples/device/fig6-qemu.png"
-elif ! cmp -s "$out/fig6.png" "$fw/fig6-qemu.png"; then
-    echo "note: examples/device/fig6-qemu.png differs from this run's image (--update-png to refresh)"
-fi
+first_of() { # scene: the first firmware of that scene
+    for f in "${firmwares[@]}"; do [[ "${f##*|}" == "$1" ]] && { echo "${f%%|*}"; return; }; done
+}
+scenes=()
+for f in "${firmwares[@]}"; do
+    s="${f##*|}"; [[ " ${scenes[*]} " == *" $s "* ]] || scenes+=("$s")
+done
+for s in "${scenes[@]}"; do
+    first=$(first_of "$s")
+    python3 "$root/tools/device/rgb565_to_png.py" "$out/$first.rgb565" "$out/$s.png" 160 120
+    echo "image: $out/$s.png"
+    if (( update_png )); then
+        cp "$out/$s.png" "$fw/$s-qemu.png"
+        echo "updated examples/device/$s-qemu.png"
+    elif ! cmp -s "$out/$s.png" "$fw/$s-qemu.png"; then
+        echo "note: examples/device/$s-qemu.png differs from this run's image (--update-png to refresh)"
+    fi
+done
 
 # --- 5. the host renders the same bytes ---------------------------------------------------
 step "host render vs device bytes (cargo test --test device)"
-fnv=$(sed -n 's/^PASS fnv1a=\(0x[0-9a-f]*\).*/\1/p' "$out/$first.log")
-(cd "$root" && CAUSTIC_DEVICE_RGB565="$out/$first.rgb565" CAUSTIC_DEVICE_FNV1A="$fnv" \
-    cargo test --test device -- --nocapture --test-threads 1) 2>&1 | tee "$out/host-test.log"
-grep -q "bit-identical to the host render" "$out/host-test.log" \
-    || { echo "run.sh: the host test did not compare the device's bytes" >&2; exit 1; }
+envs=()
+for s in "${scenes[@]}"; do
+    first=$(first_of "$s")
+    tag=$(tr '[:lower:]' '[:upper:]' <<<"$s")
+    fnv=$(sed -n 's/^PASS fnv1a=\(0x[0-9a-f]*\).*/\1/p' "$out/$first.log")
+    envs+=("CAUSTIC_DEVICE_${tag}_RGB565=$out/$first.rgb565" "CAUSTIC_DEVICE_${tag}_FNV1A=$fnv")
+done
+(cd "$root" && env "${envs[@]}" cargo test --test device -- --nocapture --test-threads 1) 2>&1 \
+    | tee "$out/host-test.log"
+for s in "${scenes[@]}"; do
+    tag=$(tr '[:lower:]' '[:upper:]' <<<"$s")
+    grep -q "^$tag: device file .* is bit-identical to the host render" "$out/host-test.log" \
+        || { echo "run.sh: the host test did not compare the device's $s bytes" >&2; exit 1; }
+done
 photon_bytes=$(sed -n 's/.*size_of Photon: \([0-9]*\) bytes$/\1/p' "$out/host-test.log")
 
 # --- 6-7. budgets, profile, one JSON line per firmware ----------------------------------
 lines=()
 for f in "${firmwares[@]}"; do
-    IFS='|' read -r name target _ _ <<<"$f"
-    elf="$fw/target/$target/release/caustic-device"
+    IFS='|' read -r name target _ _ scene <<<"$f"
+    elf="$out/$name.elf"
+    first=$(first_of "$scene")
     identical=false
     cmp -s "$out/$name.rgb565" "$out/$first.rgb565" && identical=true
     step "$name: budget"
@@ -153,11 +185,11 @@ for f in "${firmwares[@]}"; do
         "$name" "$target" "$flash" "$ram" "$stack" "$photon_bytes" "$photons" "$render" "$identical")")
     [[ "$identical" == true ]] || { echo "run.sh: $name's image differs from $first's" >&2; printf '%s\n' "${lines[@]}"; exit 1; }
 done
-first_target=$(cut -d'|' -f2 <<<"${firmwares[0]}")
+first="${firmwares[0]%%|*}"
 step "$first: instruction profile (tools/device/profile.py)"
-python3 "$root/tools/device/profile.py" --top 8 "$fw/target/$first_target/release/caustic-device" \
+python3 "$root/tools/device/profile.py" --top 8 "$out/$first.elf" \
     "$out/$first.insn.txt" | tee "$out/profile.txt"
 
 echo
-echo "run.sh: PASS (every device bit-identical to the host, fnv1a=$fnv) in $(( $(date +%s) - start )) s"
+echo "run.sh: PASS (every device bit-identical to the host) in $(( $(date +%s) - start )) s"
 printf '%s\n' "${lines[@]}"

@@ -3,8 +3,9 @@
 //! Cortex-M33 `mps2-an505`, RV32IMAC `virt`); only the reset code and the semihosting
 //! trap differ (`arm.rs`, `riscv.rs`, `semihosting.rs`).
 //!
-//! Every capacity is `caustic::budget::FIG6`: the forward pass fills a
-//! `DeviceMap<{ FIG6.stored }, { FIG6.splats }>` that lives in a `static` (in `.bss`, not on the
+//! Every capacity is `caustic::budget::FIG6` (with `--features glass`, the physical
+//! scene `caustic::demo::glass` and `caustic::budget::GLASS`): the forward pass fills a
+//! `DeviceMap<{ BUDGET.stored }, { BUDGET.splats }>` that lives in a `static` (in `.bss`, not on the
 //! stack); the backward pass renders one row at a time into a 160-pixel buffer (also
 //! static: the stack holds only the path stack, the gather and the call frames), and
 //! each row goes through `caustic::raster::DisplaySink` onto a
@@ -14,7 +15,7 @@
 //! Output (semihosting stdout): the photon and ray counts, the stack's high-water mark,
 //! and `PASS fnv1a=0x…`, the FNV-1a of the RGB565 bytes. QEMU exits with 0 on success
 //! and 1 on any failure, panic or fault. The output path is the second word of the
-//! semihosting command line (`arg=caustic,arg=PATH`), else `fig6.rgb565`.
+//! semihosting command line (`arg=caustic,arg=PATH`), else `fig6.rgb565` (`glass.rgb565`).
 //!
 //! `caustic_mark_*` are empty functions the run script's QEMU plugin recognises by
 //! address to count the instructions of each phase.
@@ -36,22 +37,39 @@ use riscv as platform;
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use caustic::budget::{DeviceMap, FIG6, FIG6_LIGHTS, FIG6_OBJECTS};
-use caustic::demo;
+use caustic::budget::DeviceMap;
 use caustic::math::Rgb;
 use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
 use caustic::render::Renderer;
 use semihosting::HostFile;
 
+/// The scene: Fig. 6 by default; `--features glass` builds the physical scene.
+#[cfg(not(feature = "glass"))]
+mod scene {
+    pub use caustic::budget::{FIG6 as BUDGET, FIG6_LIGHTS as LIGHTS, FIG6_OBJECTS as OBJECTS};
+    pub use caustic::demo::fig6 as build;
+    pub const NAME: &str = "Fig. 6";
+    pub const FILE: &[u8] = b"fig6.rgb565";
+}
+/// The scene: the glass sphere, the mirror and the floor (`demo::glass`).
+#[cfg(feature = "glass")]
+mod scene {
+    pub use caustic::budget::{GLASS as BUDGET, GLASS_LIGHTS as LIGHTS, GLASS_OBJECTS as OBJECTS};
+    pub use caustic::demo::glass as build;
+    pub const NAME: &str = "glass sphere and mirror";
+    pub const FILE: &[u8] = b"glass.rgb565";
+}
+use scene::{BUDGET, LIGHTS, OBJECTS};
+
 /// The target this firmware was built for (set by build.rs).
 const TARGET: &str = env!("CAUSTIC_FIRMWARE_TARGET");
 /// Row length, pixels.
-const WIDTH: usize = FIG6.width as usize;
+const WIDTH: usize = BUDGET.width as usize;
 
 /// What the render keeps outside the stack: the photon map (in `.bss`, counted by
 /// the linker), the row of linear radiance, and the output path.
 struct Statics {
-    map: DeviceMap<{ FIG6.stored }, { FIG6.splats }>,
+    map: DeviceMap<{ BUDGET.stored }, { BUDGET.splats }>,
     row: [Rgb; WIDTH],
     path: [u8; 256],
 }
@@ -133,41 +151,43 @@ fn fail(what: &str) -> ! {
 /// The whole run; called by the platform's reset code.
 pub fn run() -> ! {
     hprintln!(
-        "caustic on {}: Fig. 6, {}x{}, seed {}",
+        "caustic on {}: {}, {}x{}, seed {}",
         TARGET,
-        FIG6.width,
-        FIG6.height,
-        FIG6.seed
+        scene::NAME,
+        BUDGET.width,
+        BUDGET.height,
+        BUDGET.seed
     );
     let Statics { map, row, path } = take_statics().unwrap_or_else(|| fail("statics taken twice"));
-    let path = semihosting::output_path(path, b"fig6.rgb565");
+    let path = semihosting::output_path(path, scene::FILE);
 
-    let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(FIG6.width, FIG6.height)
+    let scene = scene::build::<OBJECTS, LIGHTS>(BUDGET.width, BUDGET.height)
         .unwrap_or_else(|_| fail("scene"));
-    let settings = FIG6.settings().unwrap_or_else(|_| fail("settings"));
+    let settings = BUDGET.settings().unwrap_or_else(|_| fail("settings"));
 
     caustic_mark_photons_begin();
-    let forward = map.build(&scene, &settings, FIG6.seed);
+    let forward = map.build(&scene, &settings, BUDGET.seed);
     caustic_mark_photons_end();
-    let forward = forward.unwrap_or_else(|_| fail("forward pass (more photons than FIG6.stored?)"));
+    let forward =
+        forward.unwrap_or_else(|_| fail("forward pass (more photons or splats than the budget?)"));
     hprintln!(
         "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
         forward.emitted,
         forward.stored,
-        FIG6.stored,
+        BUDGET.stored,
         map.splats().len(),
-        FIG6.splats
+        BUDGET.splats
     );
 
     let store = map
-        .store::<{ FIG6.k }>(&settings)
+        .store::<{ BUDGET.k }>(&settings)
         .unwrap_or_else(|_| fail("store"));
-    let renderer: Renderer<_, FIG6_OBJECTS, FIG6_LIGHTS, { FIG6.depth }> = map.with_splats(
+    let renderer: Renderer<_, OBJECTS, LIGHTS, { BUDGET.depth }> = map.with_splats(
         Renderer::new(&scene, &store, settings.max_depth()).unwrap_or_else(|_| fail("renderer")),
     );
     let mut file = HostFile::create(path).unwrap_or_else(|e| fail(e));
     let mut stream =
-        Rgb565Stream::<_, WIDTH>::new(FIG6.width, FIG6.height, |b: &[u8]| file.write(b))
+        Rgb565Stream::<_, WIDTH>::new(BUDGET.width, BUDGET.height, |b: &[u8]| file.write(b))
             .unwrap_or_else(|_| fail("display"));
 
     caustic_mark_render_begin();
