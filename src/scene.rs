@@ -24,6 +24,9 @@ pub struct Object {
 pub struct Scene<const OBJECTS: usize, const LIGHTS: usize> {
     camera: Camera,
     objects: FixedVec<Object, OBJECTS>,
+    /// Object indices, bounded shapes first, then planes (each group in scene order):
+    /// the order [`intersect`](Self::intersect) tries them in.
+    order: FixedVec<usize, OBJECTS>,
     lights: FixedVec<PointLight, LIGHTS>,
     background: Rgb,
     ambient: Rgb,
@@ -35,6 +38,7 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
         Self {
             camera,
             objects: FixedVec::new(),
+            order: FixedVec::new(),
             lights: FixedVec::new(),
             background: Rgb::ZERO,
             ambient: Rgb::ZERO,
@@ -43,13 +47,26 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
 
     /// Adds an object; an error when the compiled capacity is full.
     pub fn add(&mut self, shape: Shape, material: Material) -> Result<(), Error> {
+        let index = self.objects.len();
         self.objects
             .push(Object { shape, material })
             .map_err(|_| Error::Capacity {
                 what: "objects",
                 requested: OBJECTS + 1,
                 capacity: OBJECTS,
-            })
+            })?;
+        // Bounded shapes go before the first plane; cannot fail: one entry per object.
+        let at = if shape.is_bounded() {
+            let planes = self
+                .order
+                .iter()
+                .filter(|&&i| !self.objects[i].shape.is_bounded());
+            self.order.len() - planes.count()
+        } else {
+            self.order.len()
+        };
+        let _ = self.order.insert(at, index);
+        Ok(())
     }
 
     /// Adds a light; an error when the compiled capacity is full.
@@ -120,21 +137,20 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(Hit, usize)> {
         let mut best: Option<(Hit, usize)> = None;
+        // The index of `best` (0 without one: then no index is lower).
+        let mut best_index = 0;
         let mut limit = t_max;
-        for bounded in [true, false] {
-            for (i, o) in self.objects.iter().enumerate() {
-                if o.shape.is_bounded() != bounded {
-                    continue;
-                }
-                // A later index must be strictly nearer; an earlier one wins a tie.
-                let reach = match best {
-                    Some((_, j)) if j > i => next_up(limit),
-                    _ => limit,
-                };
-                if let Some(h) = o.shape.intersect(ray, reach) {
-                    limit = h.t;
-                    best = Some((h, i));
-                }
+        for &i in &self.order {
+            // A later index must be strictly nearer; an earlier one wins a tie.
+            let reach = if best_index > i {
+                next_up(limit)
+            } else {
+                limit
+            };
+            if let Some(h) = self.objects[i].shape.intersect(ray, reach) {
+                limit = h.t;
+                best_index = i;
+                best = Some((h, i));
             }
         }
         best
