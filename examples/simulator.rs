@@ -23,8 +23,7 @@
 //! | `--color rgb565\|rgb888` | the display's colour format | `rgb565` |
 //! | `--dither off\|bayer` | 4×4 Bayer dithering before RGB565 quantisation (RGB565 is **not** dithered unless asked; the device is not) | `off` |
 //! | `--scene FILE.json` | a scene file instead of the built-in Fig. 6 scene | built-in |
-//! | `--photons N` | photons per light | 2 048 (or the file's `photons.count`) |
-//! | `--seed S` | forward-pass seed | 0 |
+//! | `--photons N`, `--k K`, `--radius R`, `--max-depth D`, `--gather nearest\|radius`, `--emit cones\|sphere`, `--cone-filter K`, `--seed S` | the photon flags of `caustic render`, the same definitions ([`caustic::desktop::cli::PhotonArgs`]) and checks | the device's budget (or the file's `photons` block), seed 0 |
 //! | `--scale N` | each display pixel as N×N PNG pixels | 1 |
 //! | `-o OUT.png` | where to write the PNG | `out/simulator.png` |
 //! | `--window` | also show rows in a window as they are produced (needs SDL, below) | off |
@@ -33,8 +32,10 @@
 //! ([`caustic::desktop::MAX_OBJECTS`] objects, [`caustic::desktop::MAX_LIGHTS`] lights,
 //! gather K ≤ [`caustic::desktop::MAX_GATHER`], path stack
 //! [`caustic::desktop::MAX_DEPTH`]), which are larger than a device build's; its
-//! `photons` block is used (one pass: `passes` is ignored, as on a device) except for
-//! `--photons`, and its `image` size is replaced by the display size.
+//! `photons` block is used (one pass: `passes` is ignored, as on a device) except where
+//! a photon flag replaces one of its keys (the others, such as `gather`, stay), and its
+//! `image` size is replaced by the display size. With the built-in scene the device's
+//! capacities hold: `--k` ≤ 32 and `--max-depth` ≤ 8.
 //!
 //! # A window
 //!
@@ -58,6 +59,8 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use caustic::desktop::cli::PhotonArgs;
+use caustic::desktop::settings::{Given, SettingsInput};
 use caustic::desktop::{self, MAX_DEPTH, MAX_GATHER, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::math::Rgb;
 use caustic::photon::{self, KdTree, Photon, PhotonSettings};
@@ -65,6 +68,8 @@ use caustic::raster::{DisplaySink, Dither, ToneMap};
 use caustic::render::Renderer;
 use caustic::scene::Scene;
 use caustic::{budget, demo};
+use clap::error::ErrorKind;
+use clap::{Parser, ValueEnum};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::Size;
 use embedded_graphics_core::pixelcolor::{BinaryColor, PixelColor, Rgb565, Rgb888};
@@ -80,7 +85,7 @@ pub const DEVICE_OBJECTS: usize = budget::FIG6_OBJECTS;
 pub const DEVICE_LIGHTS: usize = budget::FIG6_LIGHTS;
 
 /// The display's colour format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ColorFormat {
     /// 16-bit RGB565, as on the device.
     Rgb565,
@@ -88,135 +93,85 @@ pub enum ColorFormat {
     Rgb888,
 }
 
-/// The command line.
-#[derive(Clone, Debug, PartialEq)]
+/// `--dither off|bayer`.
+fn dither(s: &str) -> Result<Dither, String> {
+    match s {
+        "off" | "none" => Ok(Dither::Off),
+        "bayer" => Ok(Dither::Bayer565),
+        _ => Err(format!("expected off or bayer, not {s:?}")),
+    }
+}
+
+/// The command line: the display's flags, and the photon flags of `caustic render`
+/// ([`PhotonArgs`], the same definitions).
+#[derive(Parser, Clone, Debug, PartialEq)]
+#[command(
+    name = "simulator",
+    allow_negative_numbers = true,
+    about = "Renders the device's scene (paper Fig. 6, device budget) onto a simulated \
+             160x120 RGB565 display and writes it as a PNG. RGB565 is not dithered \
+             unless --dither bayer is given. --window needs the simulator's SDL \
+             backend: see the docs in examples/simulator.rs."
+)]
 pub struct Options {
-    /// Display width in pixels.
+    /// Display width in pixels (the camera is resized to it)
+    #[arg(long, value_name = "W", default_value_t = 160,
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub width: u32,
-    /// Display height in pixels.
+    /// Display height in pixels
+    #[arg(long, value_name = "H", default_value_t = 120,
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub height: u32,
-    /// Colour format.
+    /// The display's colour format
+    #[arg(long, value_enum, default_value_t = ColorFormat::Rgb565)]
     pub color: ColorFormat,
-    /// Dithering before quantisation.
+    /// 4×4 Bayer dithering before RGB565 quantisation (off or bayer; the device does not dither)
+    #[arg(long, value_name = "off|bayer", default_value = "off", value_parser = dither)]
     pub dither: Dither,
-    /// A scene file instead of the built-in scene.
+    /// A scene file instead of the built-in Fig. 6 scene [default: built-in]
+    #[arg(long, value_name = "FILE.json")]
     pub scene: Option<PathBuf>,
-    /// Photons per light, overriding the scene's budget.
-    pub photons: Option<u32>,
-    /// Forward-pass seed.
-    pub seed: u64,
-    /// PNG pixels per display pixel.
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub budget: PhotonArgs,
+    /// Each display pixel as N×N PNG pixels
+    #[arg(long, value_name = "N", default_value_t = 1,
+          value_parser = clap::value_parser!(u32).range(1..=16))]
     pub scale: u32,
-    /// The PNG's path.
+    /// Where to write the PNG
+    #[arg(
+        short = 'o',
+        long = "out",
+        visible_alias = "output",
+        value_name = "OUT.png",
+        default_value = "out/simulator.png"
+    )]
     pub out: PathBuf,
-    /// Show an SDL window.
+    /// Also show rows in a window as they are produced (needs SDL)
+    #[arg(long)]
     pub window: bool,
 }
 
 impl Default for Options {
-    /// The device: 160×120 RGB565, undithered, built-in scene, its budget, seed 0.
+    /// The device: 160×120 RGB565, undithered, built-in scene, its budget, seed 0 (the
+    /// command line's defaults).
     fn default() -> Self {
-        Self {
-            width: 160,
-            height: 120,
-            color: ColorFormat::Rgb565,
-            dither: Dither::Off,
-            scene: None,
-            photons: None,
-            seed: 0,
-            scale: 1,
-            out: PathBuf::from("out/simulator.png"),
-            window: false,
-        }
+        Self::parse_from(["simulator"])
     }
 }
 
-const USAGE: &str = "\
-usage: simulator [--width W] [--height H] [--color rgb565|rgb888] [--dither off|bayer]
-                 [--scene FILE.json] [--photons N] [--seed S] [--scale N] [-o OUT.png]
-                 [--window]
-
-Renders the device's scene (paper Fig. 6, device budget) onto a simulated
-160x120 RGB565 display and writes it as a PNG (default out/simulator.png).
-RGB565 is not dithered unless --dither bayer is given.
---window needs the simulator's SDL backend: see the docs in examples/simulator.rs.";
-
-fn number<T: std::str::FromStr>(flag: &str, v: &str) -> Result<T, String> {
-    v.parse()
-        .map_err(|_| format!("{flag}: not a valid number: {v:?}"))
-}
-
 impl Options {
-    /// Parses the arguments after the program name. `Ok(None)` for `--help`.
+    /// Parses the arguments after the program name. `Ok(None)` for `--help` or
+    /// `--version`.
     pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Option<Self>, String> {
-        let mut o = Self::default();
-        let mut args = args.into_iter();
-        while let Some(arg) = args.next() {
-            let (flag, inline) = match arg.split_once('=') {
-                Some((f, v)) if f.starts_with("--") => (f.to_string(), Some(v.to_string())),
-                _ => (arg, None),
-            };
-            if matches!(flag.as_str(), "-h" | "--help") {
-                return Ok(None);
+        let args = std::iter::once("simulator".to_string()).chain(args);
+        let o = match Self::try_parse_from(args) {
+            Ok(o) => o,
+            Err(e) if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) => {
+                return Ok(None)
             }
-            if flag == "--window" {
-                o.window = true;
-                continue;
-            }
-            const VALUED: [&str; 11] = [
-                "--width",
-                "--height",
-                "--color",
-                "--dither",
-                "--scene",
-                "--photons",
-                "--seed",
-                "--scale",
-                "-o",
-                "--out",
-                "--output",
-            ];
-            if !VALUED.contains(&flag.as_str()) {
-                return Err(format!("unknown argument {flag:?}"));
-            }
-            let Some(value) = inline.or_else(|| args.next()) else {
-                return Err(format!("{flag}: missing value"));
-            };
-            match flag.as_str() {
-                "--width" => o.width = number(&flag, &value)?,
-                "--height" => o.height = number(&flag, &value)?,
-                "--color" => {
-                    o.color = match value.as_str() {
-                        "rgb565" => ColorFormat::Rgb565,
-                        "rgb888" => ColorFormat::Rgb888,
-                        _ => {
-                            return Err(format!(
-                                "--color: expected rgb565 or rgb888, not {value:?}"
-                            ))
-                        }
-                    }
-                }
-                "--dither" => {
-                    o.dither = match value.as_str() {
-                        "off" | "none" => Dither::Off,
-                        "bayer" => Dither::Bayer565,
-                        _ => return Err(format!("--dither: expected off or bayer, not {value:?}")),
-                    }
-                }
-                "--scene" => o.scene = Some(PathBuf::from(value)),
-                "--photons" => o.photons = Some(number(&flag, &value)?),
-                "--seed" => o.seed = number(&flag, &value)?,
-                "--scale" => o.scale = number(&flag, &value)?,
-                "-o" | "--out" | "--output" => o.out = PathBuf::from(value),
-                _ => unreachable!("{flag} is in VALUED"),
-            }
-        }
-        if o.width == 0 || o.height == 0 {
-            return Err("--width and --height must be positive".into());
-        }
-        if !(1..=16).contains(&o.scale) {
-            return Err("--scale must lie in 1..=16".into());
-        }
+            Err(e) => return Err(e.to_string()),
+        };
         if o.dither == Dither::Bayer565 && o.color != ColorFormat::Rgb565 {
             return Err(
                 "--dither bayer is scaled to RGB565 steps: use it with --color rgb565".into(),
@@ -255,12 +210,13 @@ where
     match &opts.scene {
         None => {
             let scene = demo::fig6::<DEVICE_OBJECTS, DEVICE_LIGHTS>(opts.width, opts.height)?;
-            let device = budget::FIG6.settings()?;
-            let settings = with_count(&device, opts.photons)?;
+            let device = SettingsInput::of(&budget::FIG6.settings()?);
+            let input = device.overridden_by(&opts.budget.input());
+            let settings = opts.budget.finish(input.validate(&scene)?.photons);
             draw::<_, DEVICE_OBJECTS, DEVICE_LIGHTS, DEVICE_GATHER, DEVICE_DEPTH>(
                 &scene,
                 &settings,
-                opts.seed,
+                opts.budget.seed,
                 tone,
                 opts.dither,
                 display,
@@ -268,20 +224,24 @@ where
             )
         }
         Some(path) => {
-            let mut loaded = desktop::load_scene(path)?;
+            // The display's size replaces the file's image size.
+            let flags = SettingsInput {
+                width: Some(Given::flag(opts.width)),
+                height: Some(Given::flag(opts.height)),
+                ..opts.budget.input()
+            };
+            let loaded = desktop::load_scene(path)?.with_overrides(&flags)?;
             if loaded.passes > 1 {
                 eprintln!(
                     "note: rendering one photon pass, as a device does (the file asks for {})",
                     loaded.passes
                 );
             }
-            let camera = loaded.scene.camera().with_size(opts.width, opts.height)?;
-            loaded.scene.set_camera(camera);
-            let settings = with_count(&loaded.photons, opts.photons)?;
+            let settings = opts.budget.finish(loaded.photons);
             draw::<_, MAX_OBJECTS, MAX_LIGHTS, MAX_GATHER, MAX_DEPTH>(
                 &loaded.scene,
                 &settings,
-                opts.seed,
+                opts.budget.seed,
                 tone,
                 opts.dither,
                 display,
@@ -289,23 +249,6 @@ where
             )
         }
     }
-}
-
-/// `settings` with another photon count.
-fn with_count(
-    settings: &PhotonSettings,
-    count: Option<u32>,
-) -> Result<PhotonSettings, caustic::Error> {
-    let Some(count) = count else {
-        return Ok(*settings);
-    };
-    Ok(PhotonSettings::new(
-        count,
-        settings.k(),
-        settings.max_radius(),
-        settings.max_depth(),
-    )?
-    .with_cone_filter(settings.cone_filter()))
 }
 
 /// The device's pipeline with the photon array on the heap (any `--photons`): the
@@ -414,11 +357,12 @@ fn main() {
     let opts = match Options::parse(std::env::args().skip(1)) {
         Ok(Some(o)) => o,
         Ok(None) => {
-            println!("{USAGE}");
+            // clap prints the help or the version itself.
+            let _ = Options::try_parse().map_err(|e| e.exit());
             return;
         }
         Err(e) => {
-            eprintln!("simulator: {e}\n\n{USAGE}");
+            eprintln!("simulator: {e}");
             std::process::exit(2);
         }
     };

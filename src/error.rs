@@ -46,6 +46,18 @@ pub enum Error {
         /// The compiled capacity.
         capacity: usize,
     },
+    /// A size derived from the input is too large to count (a grid side beyond `u32`).
+    TooLarge {
+        /// The quantity.
+        what: &'static str,
+        /// The size derived.
+        value: f32,
+    },
+    /// A combination of settings that this code path does not support.
+    Unsupported {
+        /// The combination.
+        what: &'static str,
+    },
 }
 
 impl fmt::Display for Error {
@@ -74,11 +86,14 @@ impl fmt::Display for Error {
                 f,
                 "{what}: {requested} requested but the compiled capacity is {capacity}"
             ),
+            Error::TooLarge { what, value } => write!(f, "{what}: {value} is too large to count"),
+            Error::Unsupported { what } => write!(f, "{what} are not supported"),
         }
     }
 }
 
 #[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 impl std::error::Error for Error {}
 
 /// `Ok(x)` when `x` is finite.

@@ -14,7 +14,19 @@
 //! ```
 //!
 //! The core is `#![no_std]` and never allocates: every capacity is a const generic.
-//! The `std` feature (default) adds scene files, the `caustic` program and image files.
+//!
+//! # Features
+//!
+//! | feature | default | adds | dependencies |
+//! |---|---|---|---|
+//! | *(none)* | | the `no_std` core: scenes, photons, stores, the renderer, tone mapping; for a microcontroller | `glam` (scalar, libm), `libm`, `heapless` |
+//! | `std` | yes | [`desktop`]: scene files (JSON), PNG, PFM and OpenEXR images, threads, progress bars | `serde`, `serde_json`, `serde_path_to_error`, `tiny-skia`, `exr`, `indicatif` |
+//! | `cli` | yes | the `caustic` program and [`desktop::cli`], its arguments shared with the examples (implies `std`) | `clap`, `clap_complete` |
+//! | `embedded-graphics` | yes | [`raster::DisplaySink`]: rows onto any `embedded-graphics` `DrawTarget` (works without `std`) | `embedded-graphics-core` |
+//!
+//! A firmware uses `default-features = false` and, for a display, `features =
+//! ["embedded-graphics"]`; a desktop library user who needs no command line can take
+//! `default-features = false, features = ["std"]`.
 //!
 //! ```
 //! use caustic::prelude::*;
@@ -46,6 +58,7 @@
 //! # Ok(()) }
 //! ```
 #![no_std]
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs, unsafe_code, rustdoc::broken_intra_doc_links)]
 #![warn(missing_debug_implementations)]
 // `!(x > 0.0)` is how this crate says "not positive, or NaN": the negation is the point.
@@ -69,6 +82,7 @@ pub mod sampling;
 pub mod scene;
 
 #[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod desktop;
 
 pub use error::Error;

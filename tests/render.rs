@@ -374,12 +374,28 @@ fn images_are_bit_identical_whatever_the_thread_count() {
             ..RenderOptions::default()
         };
         let (a, sa) = render(&scene, &settings, &one).unwrap();
-        let (b, sb) = render(&scene, &settings, &RenderOptions { threads: 5, ..one }).unwrap();
+        let (b, sb) = render(
+            &scene,
+            &settings,
+            &RenderOptions {
+                threads: 5,
+                ..one.clone()
+            },
+        )
+        .unwrap();
         assert_eq!(bits(&a), bits(&b), "{name}");
         assert_eq!((sa.rays, sa.photons_stored), (sb.rays, sb.photons_stored));
         assert!(sa.photons_stored > 0 && a.pixels.iter().all(|p| p.is_finite()));
         // Another seed gives other photons, and so another image.
-        let (c, _) = render(&scene, &settings, &RenderOptions { seed: 4, ..one }).unwrap();
+        let (c, _) = render(
+            &scene,
+            &settings,
+            &RenderOptions {
+                seed: 4,
+                ..one.clone()
+            },
+        )
+        .unwrap();
         assert_ne!(bits(&a), bits(&c), "{name}");
     }
 }
@@ -395,7 +411,15 @@ fn progressive_passes_are_bit_identical_whatever_the_thread_count() {
         ..RenderOptions::default()
     };
     let (a, sa) = render(&scene, &settings, &one).unwrap();
-    let (b, _) = render(&scene, &settings, &RenderOptions { threads: 4, ..one }).unwrap();
+    let (b, _) = render(
+        &scene,
+        &settings,
+        &RenderOptions {
+            threads: 4,
+            ..one.clone()
+        },
+    )
+    .unwrap();
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(sa.passes, 3);
     assert_eq!(sa.photons_emitted, 3 * settings.count() as u64);
@@ -560,8 +584,8 @@ fn every_scene_error_names_its_path_and_problem() {
         ),
         (
             Box::new(|v| v["image"]["width"] = json!(0)),
-            "image",
-            "image width",
+            "image.width",
+            "must lie in [1,",
         ),
         (
             Box::new(|v| v["image"]["height"] = json!(-3)),

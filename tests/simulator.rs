@@ -99,10 +99,10 @@ fn defaults_are_the_device() {
     let o = Options::parse(Vec::<String>::new()).unwrap().unwrap();
     assert_eq!((o.width, o.height), (W, H));
     assert_eq!(
-        (o.color, o.dither, o.seed),
+        (o.color, o.dither, o.budget.seed),
         (ColorFormat::Rgb565, Dither::Off, 0)
     );
-    assert_eq!((o.scene.as_ref(), o.photons), (None, None));
+    assert_eq!((o.scene.as_ref(), o.budget.count), (None, None));
 }
 
 /// The headline: the simulator's RGB565 pixels are the device's byte stream, bit for bit.
@@ -263,7 +263,57 @@ fn the_command_line_is_checked() {
     .unwrap();
     assert_eq!(o.out, std::path::PathBuf::from("x/y.png"));
     assert_eq!(
-        (o.color, o.seed, o.photons),
+        (o.color, o.budget.seed, o.budget.count),
         (ColorFormat::Rgb888, 9, Some(100))
     );
+}
+
+/// `--photons` replaces only the scene file's photon count: its gather choice stays.
+/// With `--photons 20000` the glass sphere (which gathers every photon within its
+/// radius) shows the pixels of the same file with `"count": 20000`, and not those of
+/// the k-nearest gather.
+#[test]
+fn photons_flag_keeps_the_scenes_gather() {
+    let text = std::fs::read_to_string(format!(
+        "{}/scenes/glass_sphere.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("caustic-sim-gather-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // Few photons per estimate, so that the k nearest differ from all in the radius.
+        v["photons"]["k"] = 2.into();
+        edit(&mut v);
+        let path = dir.join(name);
+        std::fs::write(&path, v.to_string()).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let original = file("original.json", &|_| {});
+    let counted = file("counted.json", &|v| v["photons"]["count"] = 20_000.into());
+    let nearest = file("nearest.json", &|v| {
+        v["photons"]["count"] = 20_000.into();
+        v["photons"]["gather"] = "nearest".into();
+    });
+    // Without camera splats the store gathers at every diffuse hit, so the gather
+    // choice shows wherever the caustic is (with them, only behind the glass).
+    let show = |args: &[&str]| {
+        let mut all = vec!["--width", "64", "--height", "48", "--no-splat", "--scene"];
+        all.extend_from_slice(args);
+        let opts = Options::parse(all.iter().map(|s| s.to_string()))
+            .unwrap()
+            .unwrap();
+        pixels(&simulate::<Rgb565>(&opts))
+    };
+    let flagged = show(&[&original, "--photons", "20000"]);
+    assert!(
+        flagged == show(&[&counted]),
+        "--photons changed more than the count"
+    );
+    assert!(
+        flagged != show(&[&nearest]),
+        "the gather choice makes no difference"
+    );
+    std::fs::remove_dir_all(dir).ok();
 }

@@ -1,14 +1,77 @@
-//! Images on disk: PNG (through tiny-skia) for looking, PFM (linear float) for measuring,
-//! and the error metrics used to compare two renders.
+//! Images on disk: PNG (through tiny-skia) for looking, PFM and OpenEXR (linear float,
+//! through the `exr` crate) for measuring, and the error metrics used to compare two
+//! renders.
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
+use std::{format, vec};
 
 use crate::math::Rgb;
 use crate::raster::ToneMap;
+
+/// The sample type of an OpenEXR file.
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ExrPrecision {
+    /// 16-bit half floats (about 3 decimal digits, up to 65504).
+    Half,
+    /// 32-bit floats: the renderer's values exactly.
+    #[default]
+    Float,
+}
+
+/// An image file format, chosen by the file name's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// `.png`: 8-bit sRGB, tone mapped.
+    Png,
+    /// `.pfm`: linear float RGB.
+    Pfm,
+    /// `.exr`: linear OpenEXR RGB.
+    Exr(ExrPrecision),
+}
+
+impl Format {
+    /// The format of `path` by its extension (any case): `.png`, `.pfm` or `.exr`
+    /// (with `exr` samples); an error naming the path otherwise, and for `-` (this
+    /// program writes files, not standard output).
+    pub fn of(path: &Path, exr: ExrPrecision) -> Result<Self, String> {
+        if path.as_os_str() == "-" {
+            return Err("-: writing to standard output is not supported; give a file name ending in .png, .pfm or .exr".into());
+        }
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(Format::Png),
+            Some("pfm") => Ok(Format::Pfm),
+            Some("exr") => Ok(Format::Exr(exr)),
+            _ => Err(format!(
+                "{}: unknown image type (the name must end in .png, .pfm or .exr)",
+                path.display()
+            )),
+        }
+    }
+}
+
+/// Checks that `path` can be written, before any work: opens it for writing (creating
+/// it, not truncating it), and removes it again if it did not exist.
+pub fn check_writable(path: &Path) -> io::Result<()> {
+    let existed = path.exists();
+    fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)?;
+    if !existed {
+        fs::remove_file(path)?;
+    }
+    Ok(())
+}
 
 /// A linear-radiance image, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -79,6 +142,96 @@ impl Image {
         pixmap
             .save_png(path)
             .map_err(|e| io::Error::other(e.to_string()))
+    }
+
+    /// Writes the image as `format`: PNG through `tone`, PFM or OpenEXR linear.
+    pub fn write(&self, path: &Path, format: Format, tone: &ToneMap) -> io::Result<()> {
+        match format {
+            Format::Png => self.write_png(path, tone),
+            Format::Pfm => self.write_pfm(path),
+            Format::Exr(p) => self.write_exr(path, p),
+        }
+    }
+
+    /// Writes an OpenEXR file of R, G, B channels (linear radiance) with `precision`
+    /// samples, single-threaded.
+    pub fn write_exr(&self, path: &Path, precision: ExrPrecision) -> io::Result<()> {
+        use exr::prelude::{f16, Image as Exr, SpecificChannels, Vec2, WritableImage};
+        let size = (self.width as usize, self.height as usize);
+        let at = |x: usize, y: usize| self.pixels[y * size.0 + x];
+        let result = match precision {
+            ExrPrecision::Float => Exr::from_channels(
+                size,
+                SpecificChannels::rgb(|Vec2(x, y)| {
+                    let c = at(x, y);
+                    (c.r, c.g, c.b)
+                }),
+            )
+            .write()
+            .non_parallel()
+            .to_file(path),
+            ExrPrecision::Half => Exr::from_channels(
+                size,
+                SpecificChannels::rgb(|Vec2(x, y)| {
+                    let c = at(x, y);
+                    (f16::from_f32(c.r), f16::from_f32(c.g), f16::from_f32(c.b))
+                }),
+            )
+            .write()
+            .non_parallel()
+            .to_file(path),
+        };
+        result.map_err(exr_io)
+    }
+
+    /// Reads the first RGB(A) layer of an OpenEXR file as float (alpha is dropped).
+    pub fn read_exr(path: &Path) -> io::Result<Image> {
+        use exr::prelude::*;
+        let image = read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |size, _| (size.width(), vec![Rgb::ZERO; size.area()]),
+                |(w, px): &mut (usize, Vec<Rgb>),
+                 Vec2(x, y),
+                 (r, g, b, _): (f32, f32, f32, f32)| {
+                    px[y * *w + x] = Rgb::new(r, g, b);
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel()
+            .from_file(path)
+            .map_err(exr_io)?;
+        let size = image.layer_data.size;
+        let (_, pixels) = image.layer_data.channel_data.pixels;
+        Ok(Self {
+            width: size.width() as u32,
+            height: size.height() as u32,
+            pixels,
+        })
+    }
+
+    /// Reads a PFM or an OpenEXR file (told apart by their first bytes); every error
+    /// names the file.
+    pub fn read(path: &Path) -> io::Result<Image> {
+        let named = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+        let mut magic = [0u8; 4];
+        let n =
+            io::Read::read(&mut fs::File::open(path).map_err(named)?, &mut magic).map_err(named)?;
+        if n == 4 && magic == [0x76, 0x2f, 0x31, 0x01] {
+            Self::read_exr(path).map_err(named)
+        } else if magic.starts_with(b"PF") {
+            Self::read_pfm(path).map_err(|e| match e.kind() {
+                io::ErrorKind::InvalidData => e,
+                _ => named(e),
+            })
+        } else {
+            Err(named(io::Error::new(
+                io::ErrorKind::InvalidData,
+                "neither a PFM nor an OpenEXR file",
+            )))
+        }
     }
 
     /// Writes a PFM: `PF`, the size, `-1.0` (little-endian), then float RGB rows from
@@ -153,8 +306,17 @@ impl Image {
     }
 }
 
-/// How far an image is from a reference.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// An `exr` error as an I/O error.
+fn exr_io(e: exr::error::Error) -> io::Error {
+    match e {
+        exr::error::Error::Io(e) => e,
+        e => io::Error::new(io::ErrorKind::InvalidData, e.to_string()),
+    }
+}
+
+/// How far an image is from a reference. In JSON (serde), a ratio that is not finite
+/// (a black reference) is `null`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ImageError {
     /// `√mean((a − b)²) / mean(b)` over all channels of the pixels compared.
     pub rel_rmse: f64,

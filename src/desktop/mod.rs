@@ -1,17 +1,25 @@
-//! The desktop side (feature `std`): scene files, images on disk, threads and progress.
+//! The desktop side (feature `std`): scene files ([`scene_file`]) and the settings
+//! they share with the command line ([`settings`], one validation for both), images on
+//! disk ([`image`]: PNG, PFM, OpenEXR), threads and progress ([`run`]), and with
+//! feature `cli` the command-line arguments of `caustic` and the examples ([`cli`]).
 //!
 //! It is thin on purpose: everything that decides a pixel's value lives in the no_std
 //! core; this module reads files, allocates the photon array on the heap, splits rows
 //! among threads, and writes files. Tests, benches and the `caustic` program all come
 //! through here, so they run the very same core as the device.
 
+#[cfg(feature = "cli")]
+#[cfg_attr(docsrs, doc(cfg(feature = "cli")))]
+pub mod cli;
 pub mod image;
 pub mod run;
 pub mod scene_file;
+pub mod settings;
 
 pub use image::Image;
 pub use run::{render, RenderOptions, RenderStats};
 pub use scene_file::{load_scene, parse_scene, LoadedScene, SceneError};
+pub use settings::{SettingsInput, StoreChoice};
 
 use crate::scene::Scene;
 

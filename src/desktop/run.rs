@@ -4,7 +4,8 @@
 //! of `(scene, settings, seed, pass)`, so the image is bit-identical whatever the
 //! number of threads: threads only change the order in which rows are computed.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -23,7 +24,7 @@ use crate::scene::Scene;
 use crate::Error;
 
 /// How to render on the desktop.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct RenderOptions {
     /// Seed of the forward pass.
     pub seed: u64,
@@ -37,6 +38,20 @@ pub struct RenderOptions {
     pub alpha: f32,
     /// How each pixel's area is sampled (default: adaptive, corners then a 4 × 4 grid).
     pub sampling: Sampling,
+    /// The cap on eye rays per pixel, ≥ 1 (`--max-rays`, `image.max_rays_per_pixel`):
+    /// every branch of a pixel's eye paths counts one ray, and a pixel stops branching
+    /// at the cap (issue 16). `None`: no cap beyond `max_depth`.
+    pub max_rays_per_pixel: Option<u32>,
+    /// Where to write the per-pixel estimated error as PFM (`--error-map`; issue 13).
+    /// Not yet read by [`render`].
+    pub error_map: Option<PathBuf>,
+    /// Render passes until the estimated relative RMSE is at most this, > 0
+    /// (`--target-error`; issue 13), instead of a fixed budget. Not yet read by
+    /// [`render`].
+    pub target_error: Option<f32>,
+    /// With `target_error`: stop after this many seconds, > 0 (`--time-limit`), even
+    /// if the target is not reached. Not yet read by [`render`].
+    pub time_limit: Option<f64>,
 }
 
 impl Default for RenderOptions {
@@ -48,6 +63,10 @@ impl Default for RenderOptions {
             passes: 1,
             alpha: 2.0 / 3.0,
             sampling: Sampling::Adaptive(REFINE),
+            max_rays_per_pixel: None,
+            error_map: None,
+            target_error: None,
+            time_limit: None,
         }
     }
 }
@@ -143,19 +162,23 @@ fn desktop_budget<const O: usize, const L: usize>(
 /// Balances the kd-tree on `threads` threads: the top levels on this one, then the
 /// subtrees below them — disjoint ranges of the array — on all, then the permutation
 /// into heap order. The same array as [`balance`], bit for bit.
-fn balance_parallel(photons: &mut [Photon], threads: usize) {
+fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress: &Progress) {
     // Below this a thread costs more than it saves.
     const SERIAL: usize = 1 << 15;
     if threads <= 1 || photons.len() < SERIAL {
+        progress.phase(pass, "balance", 1);
         balance(photons);
+        progress.tick();
         return;
     }
     let n = photons.len();
     let mut subtrees = vec::Vec::new();
     // Four subtrees per thread, rounded up to a level: balances the load.
     let levels = usize::BITS - (4 * threads - 1).leading_zeros();
+    progress.phase(pass, "balance", 0);
     photon::balance_top(photons, levels, |t| subtrees.push(t));
     subtrees.sort_by_key(|t| t.lo);
+    progress.set_steps(subtrees.len());
     // Cut the array into the subtrees' disjoint slices.
     let mut work = vec::Vec::with_capacity(subtrees.len());
     let mut rest = &mut *photons;
@@ -174,6 +197,7 @@ fn balance_parallel(photons: &mut [Photon], threads: usize) {
                 let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
                 let Some((slice, t)) = next else { break };
                 photon::balance_subtree(slice, n, t);
+                progress.tick();
             });
         }
     });
@@ -205,7 +229,7 @@ impl PhotonBuffer {
 
     /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
     /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// [`CHUNK`] and kept in emission order: the same array as the core's
+    /// `CHUNK` and kept in emission order: the same array as the core's
     /// [`photon::shoot`], whatever the thread count.
     pub fn fill<const O: usize, const L: usize>(
         &mut self,
@@ -215,6 +239,22 @@ impl PhotonBuffer {
         pass: u32,
         threads: usize,
         stats: &mut RenderStats,
+    ) -> Result<(), Error> {
+        let hidden = Progress::new(false, 1);
+        self.fill_with_progress(scene, settings, seed, pass, threads, stats, &hidden)
+    }
+
+    /// [`PhotonBuffer::fill`], showing its two phases (photons, balance) on `progress`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fill_with_progress<const O: usize, const L: usize>(
+        &mut self,
+        scene: &Scene<O, L>,
+        settings: &PhotonSettings,
+        seed: u64,
+        pass: u32,
+        threads: usize,
+        stats: &mut RenderStats,
+        progress: &Progress,
     ) -> Result<(), Error> {
         let needed = photons_needed(scene, settings);
         if needed > self.photons.len() {
@@ -234,6 +274,7 @@ impl PhotonBuffer {
                     .map(move |s| (l, s, (s + CHUNK).min(n)))
             })
             .collect();
+        progress.phase(pass, "photons", items.len());
         let results: vec::Vec<Mutex<vec::Vec<Landed>>> =
             items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
         let next = AtomicUsize::new(0);
@@ -249,6 +290,7 @@ impl PhotonBuffer {
                     if let Ok(mut slot) = results[k].lock() {
                         *slot = local;
                     }
+                    progress.tick();
                 });
             }
         });
@@ -263,7 +305,7 @@ impl PhotonBuffer {
         }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
-        balance_parallel(&mut self.photons[..stored], threads);
+        balance_parallel(&mut self.photons[..stored], threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
         stats.photons_stored += stored as u64;
@@ -307,10 +349,7 @@ pub fn render(
         ..RenderStats::default()
     };
     let mut sum = Image::new(w, h);
-    let progress = Progress::new(
-        opts.progress && std::io::stderr().is_terminal(),
-        h as usize * passes as usize,
-    );
+    let progress = Progress::new(opts.progress, passes);
     // Progressive passes gather with a fixed radius (a k-nearest radius would not
     // shrink with the passes, and the average would keep its bias).
     let settings = &settings.with_fixed_radius(settings.fixed_radius() || passes > 1);
@@ -320,10 +359,19 @@ pub fn render(
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
         let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
-        photons.fill(scene, &pass_settings, opts.seed, pass, threads, &mut stats)?;
+        photons.fill_with_progress(
+            scene,
+            &pass_settings,
+            opts.seed,
+            pass,
+            threads,
+            &mut stats,
+            &progress,
+        )?;
         let store =
             photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
         let splats = settings.camera_splats().then(|| photons.splats());
+        progress.phase(pass, "rows", h as usize);
         backward_pass(
             scene,
             &store,
@@ -415,69 +463,57 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
     total.into_inner().unwrap_or_default()
 }
 
-/// A progress bar on stderr, drawn by whichever worker finishes a row, at most ten
-/// times a second.
+/// Progress on stderr (indicatif): one bar per phase of a pass — `photons` (chunks
+/// traced), `balance` (subtrees balanced), `rows` (rows rendered) — with the pass, the
+/// phase's name, the steps done and an ETA. Hidden unless enabled and stderr is a
+/// terminal. Workers tick it from any thread.
 #[derive(Debug)]
 pub struct Progress {
-    enabled: bool,
-    total: usize,
-    done: AtomicUsize,
-    start: Instant,
-    last_draw_ms: AtomicU64,
+    bar: indicatif::ProgressBar,
+    passes: u32,
 }
 
 impl Progress {
-    /// A bar over `total` steps; draws nothing unless `enabled`.
-    pub fn new(enabled: bool, total: usize) -> Self {
-        Self {
-            enabled,
-            total: total.max(1),
-            done: AtomicUsize::new(0),
-            start: Instant::now(),
-            last_draw_ms: AtomicU64::new(0),
+    /// A bar over `passes` passes; draws nothing unless `enabled` and stderr is a
+    /// terminal.
+    pub fn new(enabled: bool, passes: u32) -> Self {
+        let bar = if enabled && std::io::stderr().is_terminal() {
+            indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::stderr())
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        let template = "{prefix:>16} [{bar:30}] {pos}/{len} {elapsed:>4} ETA {eta}";
+        if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+            bar.set_style(style.progress_chars("#>-"));
         }
+        Self { bar, passes }
+    }
+
+    /// Starts phase `name` of pass `pass` (from 0) over `steps` steps.
+    pub fn phase(&self, pass: u32, name: &str, steps: usize) {
+        let prefix = if self.passes > 1 {
+            std::format!("pass {}/{} {name}", pass + 1, self.passes)
+        } else {
+            name.into()
+        };
+        self.bar.reset();
+        self.bar.set_prefix(prefix);
+        self.bar.set_length(steps as u64);
+    }
+
+    /// The current phase has `steps` steps after all (once they are known).
+    pub fn set_steps(&self, steps: usize) {
+        self.bar.set_length(steps as u64);
     }
 
     /// One step done.
     pub fn tick(&self) {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        if !self.enabled {
-            return;
-        }
-        let now = self.start.elapsed().as_millis() as u64;
-        let last = self.last_draw_ms.load(Ordering::Relaxed);
-        if now >= last + 100
-            && self
-                .last_draw_ms
-                .compare_exchange(last, now, Ordering::Relaxed, Ordering::Relaxed)
-                .is_ok()
-        {
-            self.draw(done);
-        }
+        self.bar.inc(1);
     }
 
-    fn draw(&self, done: usize) {
-        let frac = done as f64 / self.total as f64;
-        let filled = (frac * 30.0) as usize;
-        let bar: std::string::String = (0..30)
-            .map(|i| if i < filled { '#' } else { '-' })
-            .collect();
-        let mut err = std::io::stderr().lock();
-        let _ = write!(
-            err,
-            "\r[{bar}] {:5.1}%  {:.1}s",
-            frac * 100.0,
-            self.start.elapsed().as_secs_f64()
-        );
-        let _ = err.flush();
-    }
-
-    /// Completes the bar and ends its line.
+    /// Clears the bar.
     pub fn finish(&self) {
-        if self.enabled {
-            self.draw(self.total);
-            let _ = writeln!(std::io::stderr());
-        }
+        self.bar.finish_and_clear();
     }
 }
 
@@ -493,10 +529,8 @@ pub fn render_illumination(
     texel_size: f32,
 ) -> Result<(Image, RenderStats, photon::MapStats), Error> {
     if opts.passes > 1 {
-        return Err(Error::Capacity {
+        return Err(Error::Unsupported {
             what: "progressive passes with illumination maps",
-            requested: opts.passes as usize,
-            capacity: 1,
         });
     }
     let cam = scene.camera();
@@ -510,20 +544,25 @@ pub fn render_illumination(
         ..RenderStats::default()
     };
     let needed = desktop_budget(scene, settings)?;
+    let progress = Progress::new(opts.progress, 1);
+    progress.phase(0, "photons", 1);
     let t = Instant::now();
     let mut photons = vec![Photon::ZERO; needed];
     let mut splats = vec::Vec::new();
     let f = photon::shoot_with_splats(scene, settings, opts.seed, 0, &mut photons, &mut splats)?;
+    progress.tick();
     stats.emit_ms += ms(t.elapsed());
     stats.photons_emitted = f.emitted;
     stats.photons_stored = f.stored as u64;
+    progress.phase(0, "maps", 1);
     let t = Instant::now();
     let mut maps: photon::IlluminationMaps<vec::Vec<Rgb>, { super::MAX_OBJECTS }> =
         photon::IlluminationMaps::new(vec::Vec::new(), texel_size)?;
     let map_stats = maps.build_from_photons(scene, &photons[..f.stored], f.power_unit)?;
     drop(photons);
     stats.balance_ms += ms(t.elapsed());
-    let progress = Progress::new(opts.progress && std::io::stderr().is_terminal(), h as usize);
+    progress.tick();
+    progress.phase(0, "rows", h as usize);
     let mut image = Image::new(w, h);
     let splats = settings.camera_splats().then_some(&splats[..]);
     stats.photons_splatted = splats.map_or(0, |s| s.len() as u64);

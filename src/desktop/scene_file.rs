@@ -1,5 +1,6 @@
 //! Scene files: JSON as in `shared/scene-format.md`, parsed with serde and validated
-//! by the core's constructors. Every error names its JSON path and the problem.
+//! by the core's constructors (the shared settings by [`super::settings`]). Every error
+//! names its JSON path and the problem.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -12,6 +13,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
+use super::settings::{Gather, Given, Key, SettingsInput, StoreKind};
 use super::{DesktopScene, MAX_LIGHTS, MAX_OBJECTS};
 use crate::camera::Camera;
 use crate::geometry::Shape;
@@ -21,11 +23,13 @@ use crate::math::{Rgb, Vec3};
 use crate::photon::PhotonSettings;
 use crate::Error;
 
-/// A problem with a scene file: where (a JSON path such as `objects[2].radius`, or
-/// the file) and what.
+pub use super::settings::{StoreChoice, DEFAULT_COUNT, DEFAULT_K, DEFAULT_MAX_DEPTH};
+
+/// A problem with a scene file or a flag: where (a JSON path such as
+/// `objects[2].radius`, a flag such as `--passes`, or the file) and what.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SceneError {
-    /// JSON path of the offending value (empty for the whole document).
+    /// JSON path or flag of the offending value (empty for the whole document).
     pub path: String,
     /// What is wrong.
     pub message: String,
@@ -50,20 +54,21 @@ fn err(path: impl Into<String>, message: impl Into<String>) -> SceneError {
     }
 }
 
-/// The path of a core error: `base.field` when the error names one of `fields`.
-fn core_err(base: &str, e: Error, fields: &[&str]) -> SceneError {
+/// Locates a core error: `base.field` for the field whose core label is `what` in
+/// `fields` (the constructor's labels and the JSON fields they name, matched exactly),
+/// else `base`.
+fn core_err(base: &str, e: Error, fields: &[(&str, &str)]) -> SceneError {
     let what = match e {
         Error::NotFinite { what }
         | Error::NotPositive { what, .. }
         | Error::OutOfRange { what, .. }
         | Error::Degenerate { what }
         | Error::Capacity { what, .. } => what,
+        _ => "",
     };
-    // The first field (in the caller's order of preference) that the message names.
-    let field = fields.iter().find(|f| what.contains(*f));
-    let path = match field {
-        Some(f) if base.is_empty() => f.to_string(),
-        Some(f) => format!("{base}.{f}"),
+    let path = match fields.iter().find(|(label, _)| *label == what) {
+        Some((_, f)) if base.is_empty() => f.to_string(),
+        Some((_, f)) => format!("{base}.{f}"),
         None => base.to_string(),
     };
     err(path, e.to_string())
@@ -110,6 +115,7 @@ struct CameraDef {
 struct ImageDef {
     width: u32,
     height: u32,
+    max_rays_per_pixel: Option<u32>,
 }
 
 /// The scene's `photons` block, all optional.
@@ -241,28 +247,29 @@ pub struct LoadedScene {
     pub alpha: f32,
     /// The caustic store (`photons.caustic_store`), default the kd-tree.
     pub caustic_store: StoreChoice,
+    /// The cap on eye rays per pixel (`image.max_rays_per_pixel`), if any.
+    pub max_rays_per_pixel: Option<u32>,
+    /// The file's shared settings as written, for flags to override
+    /// ([`LoadedScene::with_overrides`]).
+    pub input: SettingsInput,
 }
 
-/// Which caustic store renders the caustics (`photons.caustic_store`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub enum StoreChoice {
-    /// `{ "type": "kd_tree" }`: the photon kd-tree and its k-nearest estimate (default).
-    #[default]
-    KdTree,
-    /// `{ "type": "illumination_map", "texel_size": s }`: Arvo's illumination maps with
-    /// texels of side `s` scene units (the paper's "scale").
-    IlluminationMap {
-        /// World length of a texel's side, > 0.
-        texel_size: f32,
-    },
+impl LoadedScene {
+    /// The scene with `flags` laid over the file's settings, all validated again
+    /// (the same checks and messages as the file's keys, naming the flags).
+    pub fn with_overrides(mut self, flags: &SettingsInput) -> Result<Self, SceneError> {
+        let input = self.input.overridden_by(flags);
+        let s = input.validate(&self.scene)?;
+        self.scene.set_camera(s.camera);
+        self.input = input;
+        self.photons = s.photons;
+        self.passes = s.passes;
+        self.alpha = s.alpha;
+        self.caustic_store = s.caustic_store;
+        self.max_rays_per_pixel = s.max_rays_per_pixel;
+        Ok(self)
+    }
 }
-
-/// Default photons per light.
-pub const DEFAULT_COUNT: u32 = 100_000;
-/// Default photons per estimate.
-pub const DEFAULT_K: u32 = 64;
-/// Default specular interactions per path.
-pub const DEFAULT_MAX_DEPTH: u32 = 8;
 
 /// The type tag of a JSON object, or an error at `path.type`.
 fn type_of<'v>(v: &'v Value, path: &str, allowed: &[&str]) -> Result<&'v str, SceneError> {
@@ -291,31 +298,7 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
     let value: Value =
         serde_json::from_str(text).map_err(|e| err("", format!("invalid JSON: {e}")))?;
     let doc: FileDoc = typed(&value, "")?;
-
-    let (w, h) = doc
-        .image
-        .as_ref()
-        .map_or((320, 240), |i| (i.width, i.height));
-    let c = &doc.camera;
-    let camera = Camera::new(
-        v3(c.position),
-        v3(c.look_at),
-        v3(c.up.unwrap_or([0.0, 1.0, 0.0])),
-        c.fov_y_deg,
-        w,
-        h,
-    )
-    .map_err(|e| {
-        let path = match e {
-            Error::OutOfRange {
-                what: "image width" | "image height",
-                ..
-            } => "image",
-            _ => "camera",
-        };
-        core_err(path, e, &["look_at", "position", "up", "fov_y_deg"])
-    })?;
-    let mut scene = DesktopScene::new(camera);
+    let mut scene = DesktopScene::new(camera(&doc.camera, doc.image.as_ref())?);
     if let Some(b) = doc.background {
         scene
             .set_background(Rgb::from_array(b))
@@ -326,50 +309,106 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             .set_ambient(Rgb::from_array(a))
             .map_err(|e| core_err("ambient", e, &[]))?;
     }
+    add_lights(&mut scene, &doc.lights)?;
+    let materials = materials(&doc.materials)?;
+    add_objects(&mut scene, &doc.objects, &materials)?;
+    let input = settings_input(doc.image.as_ref(), doc.photons.unwrap_or_default())?;
+    let settings = input.validate(&scene)?;
+    Ok(LoadedScene {
+        scene,
+        photons: settings.photons,
+        passes: settings.passes,
+        alpha: settings.alpha,
+        caustic_store: settings.caustic_store,
+        max_rays_per_pixel: settings.max_rays_per_pixel,
+        input,
+    })
+}
 
-    if doc.lights.len() > MAX_LIGHTS {
+/// The camera at the file's image size (default 320×240).
+fn camera(c: &CameraDef, image: Option<&ImageDef>) -> Result<Camera, SceneError> {
+    let (w, h) = image.map_or((320, 240), |i| (i.width, i.height));
+    let up = c.up.unwrap_or([0.0, 1.0, 0.0]);
+    Camera::new(v3(c.position), v3(c.look_at), v3(up), c.fov_y_deg, w, h).map_err(|e| match e {
+        Error::OutOfRange {
+            what: what @ ("image width" | "image height"),
+            ..
+        } => {
+            let key = if what == "image width" {
+                Key::Width
+            } else {
+                Key::Height
+            };
+            err(key.json_path(), super::settings::problem(&e))
+        }
+        _ => core_err(
+            "camera",
+            e,
+            &[
+                ("camera position", "position"),
+                ("camera look_at", "look_at"),
+                ("camera look_at − position", "look_at"),
+                ("camera up", "up"),
+                ("camera forward × up", "up"),
+                ("camera fov_y_deg", "fov_y_deg"),
+            ],
+        ),
+    })
+}
+
+fn add_lights(scene: &mut DesktopScene, lights: &[Value]) -> Result<(), SceneError> {
+    if lights.len() > MAX_LIGHTS {
         return Err(err(
             "lights",
             format!(
                 "{} lights, at most {MAX_LIGHTS} are supported",
-                doc.lights.len()
+                lights.len()
             ),
         ));
     }
-    for (i, v) in doc.lights.iter().enumerate() {
+    for (i, v) in lights.iter().enumerate() {
         let path = format!("lights[{i}]");
         type_of(v, &path, &["point"])?;
         let l: PointLightDef = typed(v, &path)?;
+        let fields = [
+            ("light position", "position"),
+            ("light intensity", "intensity"),
+        ];
         let light = PointLight::new(v3(l.position), Rgb::from_array(l.intensity))
-            .map_err(|e| core_err(&path, e, &["position", "intensity"]))?;
+            .map_err(|e| core_err(&path, e, &fields))?;
         scene
             .add_light(light)
             .map_err(|e| core_err(&path, e, &[]))?;
     }
+    Ok(())
+}
 
+/// The core's labels of the material constructors and the fields they name.
+const MATERIAL_FIELDS: [(&str, &str); 12] = [
+    ("albedo", "albedo"),
+    ("reflectance", "reflectance"),
+    ("ior", "ior"),
+    ("absorption", "absorption"),
+    ("color", "color"),
+    ("ambient", "ambient"),
+    ("diffuse", "diffuse"),
+    ("specular", "specular"),
+    ("shininess", "shininess"),
+    ("reflectivity", "reflectivity"),
+    ("transparency", "transparency"),
+    ("reflectivity + transparency", "reflectivity"),
+];
+
+fn materials(defs: &BTreeMap<String, Value>) -> Result<BTreeMap<String, Material>, SceneError> {
     let mut materials = BTreeMap::new();
-    for (name, v) in &doc.materials {
+    for (name, v) in defs {
         let path = format!("materials.{name}");
-        let fields = [
-            "albedo",
-            "reflectance",
-            "ior",
-            "absorption",
-            "color",
-            "ambient",
-            "diffuse",
-            "specular",
-            "shininess",
-            "reflectivity",
-            "transparency",
-        ];
         let m = match type_of(v, &path, &["diffuse", "mirror", "dielectric", "classic"])? {
             "diffuse" => Material::diffuse(Rgb::from_array(typed::<DiffuseDef>(v, &path)?.albedo)),
-            "mirror" => Material::mirror(Rgb::from_array(
-                typed::<MirrorDef>(v, &path)?
-                    .reflectance
-                    .unwrap_or([1.0; 3]),
-            )),
+            "mirror" => {
+                let d: MirrorDef = typed(v, &path)?;
+                Material::mirror(Rgb::from_array(d.reflectance.unwrap_or([1.0; 3])))
+            }
             "dielectric" => {
                 let d: DielectricDef = typed(v, &path)?;
                 Material::dielectric(d.ior, Rgb::from_array(d.absorption.unwrap_or([0.0; 3])))
@@ -388,75 +427,75 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
                 ))
             }
         }
-        .map_err(|e| {
-            // "reflectivity + transparency" names two fields: point at the second.
-            core_err(&path, e, &fields)
-        })?;
+        .map_err(|e| core_err(&path, e, &MATERIAL_FIELDS))?;
         materials.insert(name.clone(), m);
     }
+    Ok(materials)
+}
 
-    if doc.objects.len() > MAX_OBJECTS {
+/// The core's labels of the shape constructors and the fields they name.
+const SHAPE_FIELDS: [(&str, &str); 11] = [
+    ("plane point", "point"),
+    ("plane normal", "normal"),
+    ("sphere center", "center"),
+    ("sphere radius", "radius"),
+    ("box center", "center"),
+    ("box size", "size"),
+    ("box rotation_deg", "rotation_deg"),
+    ("cylinder base", "base"),
+    ("cylinder axis", "axis"),
+    ("cylinder radius", "radius"),
+    ("cylinder height", "height"),
+];
+
+/// The shape of object `v` and the name of its material.
+fn shape(v: &Value, path: &str) -> Result<(Shape, String), SceneError> {
+    let (shape, material) = match type_of(v, path, &["plane", "sphere", "box", "cylinder"])? {
+        "plane" => {
+            let d: PlaneDef = typed(v, path)?;
+            (Shape::plane(v3(d.point), v3(d.normal)), d.material)
+        }
+        "sphere" => {
+            let d: SphereDef = typed(v, path)?;
+            (Shape::sphere(v3(d.center), d.radius), d.material)
+        }
+        "box" => {
+            let d: BoxDef = typed(v, path)?;
+            let rotation = v3(d.rotation_deg.unwrap_or([0.0; 3]));
+            (
+                Shape::cuboid(v3(d.center), v3(d.size), rotation),
+                d.material,
+            )
+        }
+        _ => {
+            let d: CylinderDef = typed(v, path)?;
+            let capped = d.capped.unwrap_or(true);
+            let (base, axis) = (v3(d.base), v3(d.axis));
+            let shape = Shape::cylinder(base, axis, d.radius, d.height, capped);
+            (shape, d.material)
+        }
+    };
+    let shape = shape.map_err(|e| core_err(path, e, &SHAPE_FIELDS))?;
+    Ok((shape, material))
+}
+
+fn add_objects(
+    scene: &mut DesktopScene,
+    objects: &[Value],
+    materials: &BTreeMap<String, Material>,
+) -> Result<(), SceneError> {
+    if objects.len() > MAX_OBJECTS {
         return Err(err(
             "objects",
             format!(
                 "{} objects, at most {MAX_OBJECTS} are supported",
-                doc.objects.len()
+                objects.len()
             ),
         ));
     }
-    for (i, v) in doc.objects.iter().enumerate() {
+    for (i, v) in objects.iter().enumerate() {
         let path = format!("objects[{i}]");
-        let (shape, material) = match type_of(v, &path, &["plane", "sphere", "box", "cylinder"])? {
-            "plane" => {
-                let d: PlaneDef = typed(v, &path)?;
-                (Shape::plane(v3(d.point), v3(d.normal)), d.material)
-            }
-            "sphere" => {
-                let d: SphereDef = typed(v, &path)?;
-                (Shape::sphere(v3(d.center), d.radius), d.material)
-            }
-            "box" => {
-                let d: BoxDef = typed(v, &path)?;
-                (
-                    Shape::cuboid(
-                        v3(d.center),
-                        v3(d.size),
-                        v3(d.rotation_deg.unwrap_or([0.0; 3])),
-                    ),
-                    d.material,
-                )
-            }
-            _ => {
-                let d: CylinderDef = typed(v, &path)?;
-                (
-                    Shape::cylinder(
-                        v3(d.base),
-                        v3(d.axis),
-                        d.radius,
-                        d.height,
-                        d.capped.unwrap_or(true),
-                    ),
-                    d.material,
-                )
-            }
-        };
-        let shape = shape.map_err(|e| {
-            core_err(
-                &path,
-                e,
-                &[
-                    "center",
-                    "radius",
-                    "size",
-                    "rotation_deg",
-                    "point",
-                    "normal",
-                    "base",
-                    "axis",
-                    "height",
-                ],
-            )
-        })?;
+        let (shape, material) = shape(v, &path)?;
         let Some(&m) = materials.get(&material) else {
             let known: Vec<&str> = materials.keys().map(String::as_str).collect();
             return Err(err(
@@ -469,35 +508,15 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
         };
         scene.add(shape, m).map_err(|e| core_err(&path, e, &[]))?;
     }
+    Ok(())
+}
 
-    let p = doc.photons.unwrap_or_default();
-    let max_radius = p.max_radius.unwrap_or_else(|| default_radius(&scene));
-    let photons = PhotonSettings::new(
-        p.count.unwrap_or(DEFAULT_COUNT),
-        p.k.unwrap_or(DEFAULT_K),
-        max_radius,
-        p.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
-    )
-    .map_err(|e| core_err("photons", e, &["k", "max_radius", "max_depth", "count"]))?;
-    if photons.k() as usize > super::MAX_GATHER {
-        return Err(err(
-            "photons.k",
-            format!(
-                "{} exceeds the gather capacity {}",
-                photons.k(),
-                super::MAX_GATHER
-            ),
-        ));
-    }
-    if photons.max_depth() as usize > super::MAX_DEPTH {
-        return Err(err(
-            "photons.max_depth",
-            format!("exceeds the path stack capacity {}", super::MAX_DEPTH),
-        ));
-    }
-    let photons = match p.gather.as_deref() {
-        None | Some("nearest") => photons,
-        Some("radius") => photons.with_fixed_radius(true),
+/// The file's shared settings as written (checked by [`SettingsInput::validate`]).
+fn settings_input(image: Option<&ImageDef>, p: PhotonsDef) -> Result<SettingsInput, SceneError> {
+    let gather = match p.gather.as_deref() {
+        None => None,
+        Some("nearest") => Some(Gather::Nearest),
+        Some("radius") => Some(Gather::Radius),
         Some(other) => {
             return Err(err(
                 "photons.gather",
@@ -505,76 +524,51 @@ pub fn parse_scene(text: &str) -> Result<LoadedScene, SceneError> {
             ));
         }
     };
-    let passes = p.passes.unwrap_or(1);
-    if passes == 0 {
-        return Err(err("photons.passes", "must be at least 1"));
-    }
-    let alpha = p.alpha.unwrap_or(2.0 / 3.0);
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(err(
-            "photons.alpha",
-            format!("must lie in (0, 1) (got {alpha})"),
-        ));
-    }
-    let mut caustic_store = StoreChoice::KdTree;
-    if let Some(store) = &p.caustic_store {
-        let path = "photons.caustic_store";
-        match type_of(store, path, &["kd_tree", "illumination_map"])? {
-            "kd_tree" if store.as_object().is_some_and(|o| o.len() == 1) => {}
-            "kd_tree" => return Err(err(path, "kd_tree takes no other field")),
-            _ => {
-                let o = store
-                    .as_object()
-                    .ok_or_else(|| err(path, "expected an object"))?;
-                if let Some(k) = o.keys().find(|k| *k != "type" && *k != "texel_size") {
-                    return Err(err(
-                        format!("{path}.{k}"),
-                        "unknown field (illumination_map takes texel_size)",
-                    ));
-                }
-                let t = o
-                    .get("texel_size")
-                    .ok_or_else(|| err(format!("{path}.texel_size"), "missing field `texel_size`"))?
-                    .as_f64()
-                    .filter(|t| t.is_finite() && *t > 0.0 && (*t as f32) > 0.0)
-                    .ok_or_else(|| {
-                        err(format!("{path}.texel_size"), "must be a positive number")
-                    })?;
-                caustic_store = StoreChoice::IlluminationMap {
-                    texel_size: t as f32,
-                };
-            }
-        }
-    }
-    Ok(LoadedScene {
-        scene,
-        photons,
-        passes,
-        alpha,
-        caustic_store,
+    let (store, texel_size) = match &p.caustic_store {
+        None => (None, None),
+        Some(v) => caustic_store(v)?,
+    };
+    Ok(SettingsInput {
+        width: image.map(|i| Given::file(i.width)),
+        height: image.map(|i| Given::file(i.height)),
+        count: p.count.map(Given::file),
+        k: p.k.map(Given::file),
+        max_radius: p.max_radius.map(Given::file),
+        max_depth: p.max_depth.map(Given::file),
+        passes: p.passes.map(Given::file),
+        alpha: p.alpha.map(Given::file),
+        gather: gather.map(Given::file),
+        store: store.map(Given::file),
+        texel_size: texel_size.map(Given::file),
+        max_rays: image.and_then(|i| i.max_rays_per_pixel).map(Given::file),
     })
 }
 
-/// A gather radius for scenes that give none: a fortieth of the largest caustic
-/// object's bounding radius (scales with the scene), or 1/100 of the camera's distance
-/// to its look-at point when there is no bounded caustic object.
-fn default_radius(scene: &DesktopScene) -> f32 {
-    let r = scene
-        .objects()
-        .iter()
-        .filter(|o| o.material.is_specular())
-        .filter_map(|o| o.shape.bounding_sphere())
-        .map(|b| b.radius)
-        .fold(0.0, f32::max);
-    if r > 0.0 {
-        r / 40.0
-    } else {
-        // Scales with the scene: a hundredth of the camera's distance from the origin.
-        let d = scene.camera().position().length();
-        if d > 0.0 {
-            0.01 * d
-        } else {
-            0.01
+/// `photons.caustic_store`: its type and, for illumination maps, its texel size.
+fn caustic_store(store: &Value) -> Result<(Option<StoreKind>, Option<f32>), SceneError> {
+    let path = "photons.caustic_store";
+    match type_of(store, path, &["kd_tree", "illumination_map"])? {
+        "kd_tree" if store.as_object().is_some_and(|o| o.len() == 1) => {
+            Ok((Some(StoreKind::Kd), None))
+        }
+        "kd_tree" => Err(err(path, "kd_tree takes no other field")),
+        _ => {
+            let o = store
+                .as_object()
+                .ok_or_else(|| err(path, "expected an object"))?;
+            if let Some(k) = o.keys().find(|k| *k != "type" && *k != "texel_size") {
+                return Err(err(
+                    format!("{path}.{k}"),
+                    "unknown field (illumination_map takes texel_size)",
+                ));
+            }
+            let t = o
+                .get("texel_size")
+                .ok_or_else(|| err(format!("{path}.texel_size"), "missing field `texel_size`"))?
+                .as_f64()
+                .ok_or_else(|| err(format!("{path}.texel_size"), "must be a positive number"))?;
+            // Checked, as `--texel-size` is, by the settings' validation.
+            Ok((Some(StoreKind::Illum), Some(t as f32)))
         }
     }
 }
@@ -584,4 +578,64 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let text = fs::read_to_string(path)
         .map_err(|e| err("", format!("cannot read {}: {e}", path.display())))?;
     parse_scene(&text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The labels in the tables are the ones the core emits: a value the core rejects
+    /// lands at its own field's path (a renamed label would land at the object's).
+    #[test]
+    fn each_core_label_maps_to_its_field() {
+        let scene = |camera: &str, light: &str, object: &str| {
+            format!(
+                r#"{{"camera": {{"position": {camera}, "look_at": [0, 0, 0], "fov_y_deg": 40}},
+                "lights": [{{"type": "point", "position": {light}, "intensity": [1, 1, 1]}}],
+                "materials": {{"m": {{"type": "diffuse", "albedo": [0.5, 0.5, 0.5]}}}},
+                "objects": [{object}]}}"#
+            )
+        };
+        let (cam, light, big) = ("[0, 1, 5]", "[0, 5, 0]", "[1e300, 0, 0]");
+        let sphere = r#"{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}"#;
+        let cases = [
+            (scene(big, light, sphere), "camera.position"),
+            (scene(cam, big, sphere), "lights[0].position"),
+            (
+                r#"{"type": "plane", "point": [1e300, 0, 0], "normal": [0, 1, 0], "material": "m"}"#
+                    .to_string(),
+                "objects[0].point",
+            ),
+            (sphere.replace("[0, 0, 0]", big), "objects[0].center"),
+            (
+                r#"{"type": "box", "center": [0, 0, 0], "size": [1, 1, 1], "rotation_deg": [1e300, 0, 0], "material": "m"}"#
+                    .to_string(),
+                "objects[0].rotation_deg",
+            ),
+            (
+                r#"{"type": "box", "center": [1e300, 0, 0], "size": [1, 1, 1], "material": "m"}"#
+                    .to_string(),
+                "objects[0].center",
+            ),
+            (cylinder("[1e300, 0, 0]", "1", "1"), "objects[0].base"),
+            (cylinder("[0, 0, 0]", "0", "1"), "objects[0].radius"),
+            (cylinder("[0, 0, 0]", "1", "0"), "objects[0].height"),
+        ];
+        for (i, (text, path)) in cases.into_iter().enumerate() {
+            let text = if text.starts_with("{\"camera") {
+                text
+            } else {
+                scene(cam, light, &text)
+            };
+            let e = parse_scene(&text).expect_err(path);
+            assert_eq!(e.path, path, "case {i}: {e}");
+        }
+    }
+
+    fn cylinder(base: &str, radius: &str, height: &str) -> String {
+        format!(
+            r#"{{"type": "cylinder", "base": {base}, "axis": [0, 1, 0], "radius": {radius},
+            "height": {height}, "material": "m"}}"#
+        )
+    }
 }

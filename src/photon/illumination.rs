@@ -132,7 +132,7 @@ impl TexelStorage for std::vec::Vec<Rgb> {
     fn texels_mut(&mut self) -> &mut [Rgb] {
         self
     }
-    /// Grows to `needed` texels, up to [`MAX_HEAP_TEXELS`]: a layout beyond it (a tiny
+    /// Grows to `needed` texels, up to `MAX_HEAP_TEXELS`: a layout beyond it (a tiny
     /// texel over photons scattered far) is an error, not an allocation that aborts.
     fn reserve(&mut self, needed: usize) -> Result<(), Error> {
         if needed > MAX_HEAP_TEXELS {

@@ -9,6 +9,7 @@ mod srgb_table;
 mod stream;
 
 #[cfg(feature = "embedded-graphics")]
+#[cfg_attr(docsrs, doc(cfg(feature = "embedded-graphics")))]
 pub use display::{DisplaySink, Dither};
 #[cfg(feature = "embedded-graphics")]
 pub use stream::{Fnv1a, Rgb565Stream, StreamError};

@@ -82,7 +82,7 @@ pub const DEFAULT_CUTOFF: f32 = 1e-4;
 /// It binds on trees built to branch (classic surfaces both reflective and
 /// transparent, deep `max_depth`); the glass sphere at 64×48 spends 1.7 eye rays a
 /// pixel on average.
-pub const DEFAULT_RAY_BUDGET: u32 = 1024;
+pub const DEFAULT_RAY_BUDGET: u32 = 4096;
 
 /// Why [`Renderer::rows`] stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]

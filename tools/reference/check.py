@@ -1,19 +1,18 @@
 #!/usr/bin/env python3
 """Self-checks of the reference renderer (run as `tools/reference/run --check [...]`).
 
-1. Analytic scenes: a diffuse floor under a point light (radiance rho*I*cos/(pi d^2) per
-   pixel), and the same floor with a diffuse sphere (shading + shadow computed here with
-   closed-form ray/sphere/plane intersections, independently of reference.py's Geometry).
-2. Caustics seen directly (L S+ D E) are estimated twice, by the photon gather at the eye
-   vertices and by splatting photons onto the pinhole: the two must agree within noise.
-3. Noise of the reference itself: relative RMSE between two seeds, full image and
-   caustic region.
-
-Either renders two seeds itself (--scene, --photons) or reads existing renders
-(--pair PREFIX1 PREFIX2, each PREFIX.pfm plus PREFIX.<part>.pfm as written by
-`run SCENE -o PREFIX.pfm --parts-prefix PREFIX`).
+1. Analytic scenes (pixel-centre rays): a diffuse floor under a point light (radiance
+   rho*I*cos/(pi d^2) per pixel), and the same floor with a diffuse sphere (shading +
+   shadow computed here with closed-form ray/sphere/plane intersections, independently of
+   reference.py's Geometry).
+2. Noise of a reference (--pair PREFIX1 PREFIX2, two seeds rendered with
+   `run SCENE -o PREFIX.pfm --parts-prefix PREFIX --json PREFIX.json`): relative RMSE
+   between the seeds, full image and caustic region; --json writes it with both runs'
+   statistics (tests/data/NAME.ref.json).
+The comparison with Mitsuba's ptracer is ptracer.py (`run --ptracer`).
 """
 import argparse
+import json
 import math
 import os
 import sys
@@ -21,6 +20,7 @@ import time
 
 import numpy as np
 
+import pixel
 import reference as R
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -40,11 +40,9 @@ def rel_rmse(a, b, mask=None):
     return float(np.sqrt((d ** 2).mean()) / m) if m > 0 else float("nan")
 
 
-def caustic_mask(caustic, direct):
-    """Caustic region: caustic radiance > 25 % of the median directly lit radiance."""
-    dl = lum(direct)
-    ref = np.median(dl[dl > 0]) if (dl > 0).any() else 1.0
-    return lum(caustic) > 0.25 * ref
+def caustic_mask(caustic, full):
+    """Caustic region: pixels whose caustic part is >= 10 % of the pixel's luminance."""
+    return lum(caustic) >= 0.1 * lum(full)
 
 
 def bin2(a):
@@ -132,7 +130,7 @@ def check_analytic(W, H):
     for with_sphere in (False, True):
         js = analytic_scene(with_sphere)
         scene = R.parse_scene(js)
-        full, parts, _ = R.render(scene, W, H, 1000, 1, 0.015, quiet=True)
+        full, parts, _, _ = pixel.render(scene, W, H, 1000, 1, 0.003, quiet=True, centre=True)
         full = full.reshape(H, W, 3)
         ref = analytic_image(js, W, H)
         err = np.abs(full - ref) / np.maximum(ref, 1e-6)
@@ -144,10 +142,10 @@ def check_analytic(W, H):
     return rows
 
 
-# ----------------------------------------------------------------------------- checks 2, 3
+# ----------------------------------------------------------------------------- noise
 def load_prefix(prefix):
     out = {"full": R.read_pfm(prefix + ".pfm")}
-    for k in ("direct", "caustic", "background", "caustic_direct_seen", "splat"):
+    for k in ("caustic", "splat", "gather", "gather2", "direct_seen", "direct_through", "background"):
         f = f"{prefix}.{k}.pfm"
         if os.path.exists(f):
             out[k] = R.read_pfm(f)
@@ -155,91 +153,68 @@ def load_prefix(prefix):
 
 
 def compare_pair(A, B):
-    mask = caustic_mask(0.5 * (A["caustic"] + B["caustic"]), 0.5 * (A["direct"] + B["direct"]))
-    res = dict(mask_pixels=int(mask.sum()))
-    res["noise_full_pair"] = rel_rmse(A["full"], B["full"])
-    res["noise_caustic_pair"] = rel_rmse(A["full"], B["full"], mask)
-    res["noise_causticpart_pair"] = rel_rmse(A["caustic"], B["caustic"], mask)
-    if "splat" in A and "splat" in B:
-        g = 0.5 * (A["caustic_direct_seen"] + B["caustic_direct_seen"])
-        s = 0.5 * (A["splat"] + B["splat"])
-        # region where the caustic is seen directly (not through glass)
-        m2 = caustic_mask(g, 0.5 * (A["direct"] + B["direct"]))
-        res["splat_mask_pixels"] = int(m2.sum())
-        res["sum_ratio_splat_over_gather"] = float(s[m2].sum() / g[m2].sum())
-        res["rmse_splat_vs_gather"] = rel_rmse(s, g, m2)
-        res["noise_gather_pair"] = rel_rmse(A["caustic_direct_seen"], B["caustic_direct_seen"], m2)
-        res["noise_splat_pair"] = rel_rmse(A["splat"], B["splat"], m2)
-        m2b = bin2(m2[..., None].astype(float))[..., 0] > 0.5
-        res["rmse_splat_vs_gather_2x2"] = rel_rmse(bin2(s), bin2(g), m2b)
-        res["noise_gather_pair_2x2"] = rel_rmse(bin2(A["caustic_direct_seen"]), bin2(B["caustic_direct_seen"]), m2b)
-        res["noise_splat_pair_2x2"] = rel_rmse(bin2(A["splat"]), bin2(B["splat"]), m2b)
+    """Relative RMSE between two seeds, full image and caustic region (one image's own
+    noise is that / sqrt(2)); also per part, and over 2x2 bins."""
+    mask = caustic_mask(0.5 * (A["caustic"] + B["caustic"]), 0.5 * (A["full"] + B["full"]))
+    res = dict(caustic_px=int(mask.sum()),
+               pair_rel_rmse_full=rel_rmse(A["full"], B["full"]),
+               pair_rel_rmse_caustic_region=rel_rmse(A["full"], B["full"], mask),
+               pair_rel_rmse_caustic_part_in_region=rel_rmse(A["caustic"], B["caustic"], mask))
+    m2 = bin2(mask[..., None].astype(float))[..., 0] > 0.5
+    res["pair_rel_rmse_full_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]))
+    res["pair_rel_rmse_caustic_region_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]), m2)
+    if "gather2" in A and "gather2" in B:
+        # kernel bias of the gather: bias(r) ~ D (edges, bias ~ r) or D/3 (smooth, ~ r^2),
+        # D = gather(2r) - gather(r) on the same vertices and photons, mean of both seeds
+        D = 0.5 * ((A["gather2"] - A["gather"]) + (B["gather2"] - B["gather"]))
+        full = 0.5 * (A["full"] + B["full"])
+        res["gather_2r_minus_r_rel_rms_full"] = float(np.sqrt((D ** 2).mean()) / full.mean())
+        res["gather_2r_minus_r_rel_rms_caustic_region"] = float(np.sqrt((D[mask] ** 2).mean()) / full[mask].mean())
+        res["gather_2r_minus_r_rel_sum"] = float(D.sum() / full.sum())
+    for k in ("direct_seen", "direct_through", "splat", "gather"):
+        if k in A and k in B:
+            res[f"sum_{k}"] = float(0.5 * (A[k] + B[k]).sum() / (0.5 * (A["full"] + B["full"])).sum())
     return res
-
-
-def print_pair(name, res, splat_check=True):
-    print(f"\n[{name}]")
-    print(f"  caustic region: {res['mask_pixels']} px (caustic part > 25% of median direct radiance)")
-    print("  check 3, noise of the reference (relative RMSE between two seeds; one image's own")
-    print("  noise is that / sqrt(2)):")
-    print(f"    {'full image':<34} {res['noise_full_pair']:.4f}")
-    print(f"    {'caustic region, full image':<34} {res['noise_caustic_pair']:.4f}")
-    print(f"    {'caustic region, caustic part':<34} {res['noise_causticpart_pair']:.4f}")
-    if splat_check and "rmse_splat_vs_gather" in res:
-        print(f"  check 2, caustics seen directly, region {res['splat_mask_pixels']} px (seed-averaged images):")
-        print(f"    {'sum(splat) / sum(gather)':<34} {res['sum_ratio_splat_over_gather']:.4f}")
-        print(f"    {'':<34} {'per pixel':>10} {'2x2 bins':>10}")
-        print(f"    {'rel RMSE splat vs gather':<34} {res['rmse_splat_vs_gather']:>10.4f} {res['rmse_splat_vs_gather_2x2']:>10.4f}")
-        print(f"    {'gather seed-pair rel RMSE':<34} {res['noise_gather_pair']:>10.4f} {res['noise_gather_pair_2x2']:>10.4f}")
-        print(f"    {'splat seed-pair rel RMSE':<34} {res['noise_splat_pair']:>10.4f} {res['noise_splat_pair_2x2']:>10.4f}")
-        # expected difference of the two seed-averaged estimates if unbiased: each average has
-        # variance pair^2/4, so |s-g| ~ sqrt(pair_g^2 + pair_s^2)/2
-        exp = 0.5 * math.hypot(res["noise_gather_pair"], res["noise_splat_pair"])
-        exp2 = 0.5 * math.hypot(res["noise_gather_pair_2x2"], res["noise_splat_pair_2x2"])
-        print(f"    {'expected from noise alone':<34} {exp:>10.4f} {exp2:>10.4f}")
 
 
 def main(argv):
     ap = argparse.ArgumentParser(prog="run --check")
-    ap.add_argument("--scene", default=os.path.join(REPO, "scenes", "glass_sphere.json"))
-    ap.add_argument("--photons", type=int, default=20_000_000)
-    ap.add_argument("--radius", type=float, default=0.015)
     ap.add_argument("--width", type=int, default=160)
     ap.add_argument("--height", type=int, default=120)
-    ap.add_argument("--pair", nargs=2, metavar="PREFIX", help="compare two existing renders instead of rendering")
+    ap.add_argument("--pair", nargs=2, metavar="PREFIX", help="noise between two renders (seeds) of one scene")
+    ap.add_argument("--json", help="with --pair: write the noise figures and both runs' statistics (PREFIX.json) here")
+    ap.add_argument("--mean-to", metavar="PREFIX",
+                    help="with --pair: write the mean of the two seeds as PREFIX.pfm and PREFIX.caustic.pfm")
     ap.add_argument("--skip-analytic", action="store_true")
-    ap.add_argument("--supersample", type=int, default=4,
-                    help="K x K eye rays per pixel for the self-rendered pair (so that the gather, too, is a pixel-area average)")
-    ap.add_argument("--splat-check", action="store_true", help="with --pair: also compare splat vs gather (renders made with --supersample > 1)")
     args = ap.parse_args(argv)
     W, H = args.width, args.height
     if not args.skip_analytic:
         t0 = time.time()
         rows = check_analytic(W, H)
-        print(f"check 1, analytic scenes ({W}x{H}, {time.time() - t0:.1f}s):")
+        print(f"check 1, analytic scenes ({W}x{H}, pixel-centre rays, {time.time() - t0:.1f}s):")
         print(f"  {'scene':<24} {'rel err':>10} {'px >1e-4':>9} {'of':>6} {'max caustic':>12}")
         for name, e, nbad, n, mc in rows:
             tag = "(max)" if name == "floor only" else "(median)"
             print(f"  {name:<24} {e:>10.2e} {nbad:>9d} {n:>6d} {mc:>12.1e}   rel err {tag}")
     if args.pair:
         A, B = load_prefix(args.pair[0]), load_prefix(args.pair[1])
-        # check 2 needs pixel-area averages on both sides (--supersample > 1): with one ray
-        # per pixel the gather is a point sample at the pixel centre, the splat an average.
-        print_pair(f"{args.pair[0]} vs {args.pair[1]}", compare_pair(A, B), splat_check=args.splat_check)
-        return 0
-    scene = R.load_scene(args.scene)
-    imgs = []
-    for seed in (1, 2):
-        t0 = time.time()
-        full, parts, st = R.render(scene, W, H, args.photons, seed, args.radius, quiet=True, ss=args.supersample)
-        d = {k: v.reshape(H, W, 3) for k, v in parts.items()}
-        d["full"] = full.reshape(H, W, 3)
-        imgs.append(d)
-        print(f"rendered {os.path.basename(args.scene)} seed {seed}: {args.photons} photons, "
-              f"{args.supersample}x{args.supersample} eye rays per pixel, "
-              f"{time.time() - t0:.0f}s", flush=True)
-    print_pair(f"{os.path.basename(args.scene)}, {args.photons} photons, r={args.radius}, "
-               f"supersample {args.supersample}", compare_pair(*imgs))
+        res = compare_pair(A, B)
+        print(json.dumps(res, indent=1))
+        if args.mean_to:
+            H, W = A["full"].shape[:2]
+            for suffix, k in (("", "full"), (".caustic", "caustic")):
+                R.write_pfm(f"{args.mean_to}{suffix}.pfm", (0.5 * (A[k] + B[k])).reshape(-1, 3), W, H)
+            # the mean of two independent renders has rel. RMSE pair / 2 (variance sigma^2 / 2)
+            res["mean_of_seeds_rel_rmse_full"] = res["pair_rel_rmse_full"] / 2
+            res["mean_of_seeds_rel_rmse_caustic_region"] = res["pair_rel_rmse_caustic_region"] / 2
+        if args.json:
+            runs = []
+            for p in args.pair:
+                if os.path.exists(p + ".json"):
+                    with open(p + ".json") as f:
+                        runs.append(json.load(f))
+            with open(args.json, "w") as f:
+                json.dump(dict(noise=res, runs=runs), f, indent=1)
     return 0
 
 

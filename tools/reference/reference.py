@@ -1,16 +1,16 @@
 #!/usr/bin/env python3
 """Independent reference renderer for caustic scenes (see README.md).
 
-Light transport (exactly the model caustic implements, nothing more):
-  * direct part   L D S* E : deterministic Whitted eye-path tree (both Fresnel branches
-                              followed), point-light direct illumination at diffuse vertices;
-  * caustic part  L S+ D S* E : photons traced from the lights through mirrors/dielectrics
-                              and gathered, with a small kernel radius and a very large photon
-                              count, at every diffuse eye vertex (weighted by its path weight);
-  * background    rays that leave the scene.
-Independently of the gather, the caustics seen directly (L S+ D E) are also estimated by
-splatting each deposited photon onto the pinhole camera (light tracing); `--check` compares
-the two.
+Pixel-area averages (box filter) of exactly the light transport of the scene contract:
+  * direct         L D S* E     random sub-pixel eye samples (pixel.py), adaptive per pixel;
+  * caustic, seen directly  L S+ D E   light tracing: every photon deposit connected to the
+                                pinhole and added to the pixel it projects into (Splat);
+  * caustic, seen through glass / in a mirror  L S+ D S+ E   the eye samples gather the
+                                photon map with a disk far below a pixel's footprint (pixel.py);
+  * background     rays that leave the scene.
+This file holds the scene parser, the ray queries, the optics, the camera, the photon
+tracer and the splat; pixel.py the eye sampling and the gather; check.py and ptracer.py
+the checks.
 
 Ray queries use Mitsuba 3 (llvm_ad_rgb) for spheres, boxes, cylinders and their caps.
 Infinite planes are intersected analytically in float64 (a finite Mitsuba rectangle large
@@ -334,16 +334,10 @@ class Camera:
         self.half_h = math.tan(math.radians(cam["fov"]) / 2)
         self.half_w = self.half_h * W / H
 
-    def rays(self, ss=1):
-        """One ray through each pixel centre (ss=1), or ss x ss stratified sub-pixel
-        centres per pixel (pixel index = ray index // ss^2) for pixel-area averages."""
-        W, H = self.W, self.H
-        y, x = np.mgrid[0:H, 0:W]
-        j, i = np.mgrid[0:ss, 0:ss]
-        fx = (x.ravel()[:, None] + (i.ravel()[None] + 0.5) / ss).ravel()
-        fy = (y.ravel()[:, None] + (j.ravel()[None] + 0.5) / ss).ravel()
-        u = (2 * fx / W - 1) * self.half_w
-        v = (1 - 2 * fy / H) * self.half_h
+    def rays_at(self, fx, fy):
+        """Rays through image points (fx, fy) in pixel units (x right, y down)."""
+        u = (2 * fx / self.W - 1) * self.half_w
+        v = (1 - 2 * fy / self.H) * self.half_h
         d = self.fwd[None] + u[:, None] * self.right[None] + v[:, None] * self.up[None]
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         o = np.repeat(self.pos[None], len(d), axis=0)
@@ -351,89 +345,6 @@ class Camera:
 
     def pixel_area(self):
         return (2 * self.half_w / self.W) * (2 * self.half_h / self.H)
-
-
-# ----------------------------------------------------------------------------- eye paths
-def trace_eye(scene, geo, cam, ss=1):
-    """Deterministic eye-path tree. Returns images (direct, background) and the diffuse
-    vertices (pixel, weight, p, obj, albedo, nspec) at which caustics must be gathered."""
-    W, H = cam.W, cam.H
-    direct = np.zeros((W * H, 3))
-    backgr = np.zeros((W * H, 3))
-    o, d = cam.rays(ss)
-    pix = np.arange(len(d)) // (ss * ss)
-    w = np.full((len(d), 3), 1.0 / (ss * ss))
-    nspec = np.zeros(len(d), np.int64)
-    medium = np.full(len(d), -1, np.int64)
-    verts = []
-    objs = scene["objects"]
-    max_depth = scene["max_depth"]
-    total_rays = 0
-    while len(o):
-        total_rays += len(o)
-        t, obj, p, n = geo.intersect(o, d)
-        # Beer absorption of the segment just travelled inside a dielectric
-        for i, ob in enumerate(objs):
-            m = (medium == i) & np.isfinite(t)
-            if m.any() and ob["mat"]["type"] == "dielectric":
-                w[m] *= np.exp(-ob["mat"]["absorption"][None] * t[m, None])
-        miss = obj < 0
-        np.add.at(backgr, pix[miss], w[miss] * scene["background"][None])
-        new = []
-        for i, ob in enumerate(objs):
-            m = obj == i
-            if not m.any():
-                continue
-            mat = ob["mat"]
-            pp, nn, dd, ww, px, ns, md = p[m], n[m], d[m], w[m], pix[m], nspec[m], medium[m]
-            if mat["type"] == "diffuse":
-                front = np.sum(dd * nn, axis=1) < 0
-                pp, nn, ww, px, ns = pp[front], nn[front], ww[front], px[front], ns[front]
-                rho = mat["albedo"]
-                for L in scene["lights"]:
-                    lv = L["position"] - pp
-                    dist = np.linalg.norm(lv, axis=1)
-                    ldir = lv / dist[:, None]
-                    cos = np.sum(nn * ldir, axis=1)
-                    ok = cos > 0
-                    o2 = pp[ok] + EPS * nn[ok]
-                    vis = np.zeros(len(pp), bool)
-                    vis[ok] = ~geo.occluded(o2, ldir[ok], np.linalg.norm(L["position"] - o2, axis=1) * (1 - 1e-6) - EPS)
-                    c = np.where(vis, cos / dist ** 2, 0.0)
-                    np.add.at(direct, px, ww * (rho / math.pi)[None] * L["intensity"][None] * c[:, None])
-                verts.append((px, ww, pp, np.full(len(px), i), ns))
-                continue
-            ok = ns < max_depth  # a further specular interaction beyond max_depth: nothing
-            pp, nn, dd, ww, px, ns, md = pp[ok], nn[ok], dd[ok], ww[ok], px[ok], ns[ok], md[ok]
-            if not len(pp):
-                continue
-            if mat["type"] == "mirror":
-                rd = reflect(dd, nn)
-                new.append((offset(pp, nn, rd), rd, ww * mat["reflectance"][None], px, ns + 1, md))
-            else:
-                F, td, tir, eta_i, eta_t, entering = fresnel_refract(dd, nn, mat["ior"])
-                rd = reflect(dd, nn)
-                new.append((offset(pp, nn, rd), rd, ww * F[:, None], px, ns + 1, md))
-                r = ~tir
-                wt = ww[r] * ((1 - F[r]) * (eta_i[r] / eta_t[r]) ** 2)[:, None]
-                md_t = np.where(entering[r], i, -1)
-                new.append((offset(pp[r], nn[r], td[r]), td[r], wt, px[r], ns[r] + 1, md_t))
-        if not new:
-            break
-        o = np.concatenate([x[0] for x in new])
-        d = np.concatenate([x[1] for x in new])
-        w = np.concatenate([x[2] for x in new])
-        pix = np.concatenate([x[3] for x in new])
-        nspec = np.concatenate([x[4] for x in new])
-        medium = np.concatenate([x[5] for x in new])
-        keep = np.any(w > 0, axis=1)
-        o, d, w, pix, nspec, medium = o[keep], d[keep], w[keep], pix[keep], nspec[keep], medium[keep]
-    V = dict(pix=np.concatenate([v[0] for v in verts]) if verts else np.zeros(0, np.int64),
-             w=np.concatenate([v[1] for v in verts]) if verts else np.zeros((0, 3)),
-             p=np.concatenate([v[2] for v in verts]) if verts else np.zeros((0, 3)),
-             obj=np.concatenate([v[3] for v in verts]) if verts else np.zeros(0, np.int64),
-             nspec=np.concatenate([v[4] for v in verts]) if verts else np.zeros(0, np.int64))
-    return direct, backgr, V, total_rays
 
 
 # ----------------------------------------------------------------------------- photons
@@ -446,6 +357,20 @@ def bounding_sphere(ob):
     if t == "cylinder":
         return ob["base"] + 0.5 * ob["height"] * ob["axis"], math.hypot(ob["radius"], 0.5 * ob["height"])
     return None, None
+
+
+def unit_square(rng, n):
+    """n points in [0,1)^2: an Owen-scrambled Sobol' set (scipy.stats.qmc) drawn from rng.
+    Each point is marginally uniform (so every photon has exactly the pdf its weight
+    assumes: unbiased), and the set is stratified, which lowers the variance of the photon
+    count reaching a pixel where the light's directions map smoothly onto the caustic."""
+    import warnings
+    from scipy.stats import qmc
+    if n == 0:
+        return np.zeros((0, 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # balance warning for n not a power of 2
+        return qmc.Sobol(d=2, scramble=True, seed=rng).random(n)
 
 
 class Emitter:
@@ -479,8 +404,9 @@ class Emitter:
 
     def sample(self, rng, n):
         if self.full:
-            z = rng.uniform(-1, 1, n)
-            phi = rng.uniform(0, 2 * math.pi, n)
+            u = unit_square(rng, n)
+            z = 2 * u[:, 0] - 1
+            phi = 2 * math.pi * u[:, 1]
             s = np.sqrt(1 - z * z)
             d = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
             return d, np.full(n, 4 * math.pi)
@@ -490,8 +416,9 @@ class Emitter:
         for j, (ax, cm, _) in enumerate(self.cones):
             m = k == j
             nm = int(m.sum())
-            cz = 1 - rng.uniform(0, 1, nm) * (1 - cm)
-            phi = rng.uniform(0, 2 * math.pi, nm)
+            u = unit_square(rng, nm)
+            cz = 1 - u[:, 0] * (1 - cm)
+            phi = 2 * math.pi * u[:, 1]
             s = np.sqrt(np.maximum(0, 1 - cz * cz))
             F = frame_z_to(ax)
             d[m] = (np.stack([s * np.cos(phi), s * np.sin(phi), cz], axis=1)) @ F.T
@@ -562,46 +489,6 @@ def trace_photons(scene, geo, emitter, rng, n):
 
 
 # ----------------------------------------------------------------------------- estimators
-class Gather:
-    """Disk-kernel density estimate of caustic irradiance at fixed gather points, fed with
-    photon batches: E(x) = sum_{|x_i - x| < r, same surface} Phi_i / (pi r^2)."""
-
-    def __init__(self, V, radius):
-        from scipy.spatial import cKDTree
-        self.cKDTree = cKDTree
-        self.r = radius
-        self.V = V
-        self.E = np.zeros((len(V["pix"]), 3))
-        self.count = np.zeros(len(V["pix"]), np.int64)
-        self.trees = {}
-        for i in np.unique(V["obj"]):
-            idx = np.nonzero(V["obj"] == i)[0]
-            self.trees[int(i)] = (idx, cKDTree(V["p"][idx]))
-
-    def add(self, dep):
-        p, obj, pw, _ = dep
-        for i, (idx, tree) in self.trees.items():
-            m = obj == i
-            if not m.any():
-                continue
-            pt = self.cKDTree(p[m])
-            pairs = tree.sparse_distance_matrix(pt, self.r, output_type="ndarray")
-            gi = idx[pairs["i"]]
-            pwm = pw[m]
-            for c in range(3):
-                self.E[:, c] += np.bincount(gi, weights=pwm[pairs["j"], c], minlength=len(self.E))
-            self.count += np.bincount(gi, minlength=len(self.E))
-
-    def image(self, scene, W, H, only_direct_seen=False):
-        V = self.V
-        img = np.zeros((W * H, 3))
-        sel = (V["nspec"] == 0) if only_direct_seen else np.ones(len(V["pix"]), bool)
-        alb = np.array([scene["objects"][i]["mat"]["albedo"] for i in V["obj"]]) if len(V["obj"]) else np.zeros((0, 3))
-        L = V["w"] * alb / math.pi * self.E / (math.pi * self.r ** 2)
-        np.add.at(img, V["pix"][sel], L[sel])
-        return img
-
-
 class Splat:
     """Light-tracing estimate of caustics seen directly (L S+ D E): each deposited photon
     is connected to the pinhole; the estimate is the pixel-area average of radiance over
@@ -667,49 +554,6 @@ def init_mitsuba():
     mi.set_variant("llvm_ad_rgb")
 
 
-def render(scene, W, H, photons, seed, radius, batch=1_000_000, splat=True, quiet=False, ss=1):
-    init_mitsuba()
-    t0 = time.time()
-    geo = Geometry(scene)
-    cam = Camera(scene["camera"], W, H)
-    direct, backgr, V, eye_rays = trace_eye(scene, geo, cam, ss)
-    t_eye = time.time() - t0
-    if not quiet:
-        log(f"eye paths: {eye_rays} rays, {len(V['pix'])} diffuse vertices, {t_eye:.1f}s")
-    gather = Gather(V, radius)
-    spl = Splat(scene, geo, cam) if splat else None
-    rng = np.random.default_rng(seed)
-    ph_rays = 0
-    ndep = 0
-    for L in scene["lights"]:
-        em = Emitter(L, scene["objects"])
-        if em.omega == 0:
-            continue
-        done = 0
-        while done < photons:
-            nb = min(batch, photons - done)
-            dep, r = trace_photons(scene, geo, em, rng, nb)
-            # the batch is normalised for nb photons: rescale to the total count
-            dep = (dep[0], dep[1], dep[2] * (nb / photons), dep[3])
-            ph_rays += r
-            ndep += len(dep[0])
-            gather.add(dep)
-            if spl is not None:
-                spl.add(dep)
-            done += nb
-            if not quiet:
-                log(f"  photons {done}/{photons} ({ndep} deposits, {time.time() - t0:.0f}s)")
-    caustic = gather.image(scene, W, H)
-    stats = dict(eye_rays=eye_rays, photon_rays=ph_rays, deposits=ndep, seconds=time.time() - t0,
-                 gather_vertices=len(V["pix"]), mean_photons_per_gather=float(gather.count[gather.count > 0].mean()) if (gather.count > 0).any() else 0.0)
-    parts = dict(direct=direct, caustic=caustic, background=backgr,
-                 caustic_direct_seen=gather.image(scene, W, H, only_direct_seen=True))
-    if spl is not None:
-        parts["splat"] = spl.img
-    full = direct + caustic + backgr
-    return full, parts, stats
-
-
 def load_scene(path):
     with open(path) as f:
         js = json.load(f)
@@ -724,16 +568,21 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene", nargs="?")
     ap.add_argument("-o", "--output")
-    ap.add_argument("--width", type=int, default=160)
-    ap.add_argument("--height", type=int, default=120)
-    ap.add_argument("--photons", type=int, default=60_000_000, help="photons emitted per light (into the cones around the specular objects)")
+    ap.add_argument("--width", type=int, default=320)
+    ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--photons", type=int, default=20_000_000, help="photons emitted per light (into the cones around the specular objects)")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--radius", type=float, default=0.015, help="gather kernel radius (scene units)")
+    ap.add_argument("--radius", type=float, default=0.0015,
+                    help="largest disk radius of the gather at diffuse points seen through glass or in a mirror (scene units)")
+    ap.add_argument("--radius-frac", type=float, default=0.05,
+                    help="gather radius = this fraction of the pixel footprint's side at the vertex (at most --radius)")
+    ap.add_argument("--spp", type=int, default=64, help="pilot eye samples per pixel (uniform random points)")
+    ap.add_argument("--spp-max", type=int, default=4096, help="adaptive cap of eye samples per pixel")
+    ap.add_argument("--tol", type=float, default=0.01,
+                    help="adaptive target: standard error of a pixel <= tol * max(pixel, 5%% of the mean)")
     ap.add_argument("--batch", type=int, default=1_000_000)
-    ap.add_argument("--parts-prefix")
-    ap.add_argument("--supersample", type=int, default=1, metavar="K",
-                    help="K x K eye rays per pixel (pixel-area average); 1 = one ray through the centre, as caustic")
-    ap.add_argument("--no-splat", action="store_true")
+    ap.add_argument("--parts-prefix", help="also write PREFIX.<part>.pfm for each part and PREFIX.spp.pfm")
+    ap.add_argument("--json", help="write the run's statistics (photons, spp, seed, time) to this file")
     ap.add_argument("--check", action="store_true", help="run the self-checks (check.py) instead")
     args = ap.parse_args(argv)
     if not args.scene or not args.output:
@@ -743,12 +592,20 @@ def main(argv=None):
     except SceneError as e:
         log(f"error: {args.scene}: {e}")
         return 2
-    full, parts, stats = render(scene, args.width, args.height, args.photons, args.seed, args.radius,
-                                batch=args.batch, splat=not args.no_splat, ss=args.supersample)
-    write_pfm(args.output, full, args.width, args.height)
+    import pixel
+    full, parts, stats, nsamp = pixel.render(scene, args.width, args.height, args.photons, args.seed, args.radius,
+                                             radius_frac=args.radius_frac, spp=args.spp, spp_max=args.spp_max, tol=args.tol, batch=args.batch)
+    W, H = args.width, args.height
+    write_pfm(args.output, full, W, H)
     if args.parts_prefix:
         for k, v in parts.items():
-            write_pfm(f"{args.parts_prefix}.{k}.pfm", v, args.width, args.height)
+            write_pfm(f"{args.parts_prefix}.{k}.pfm", v, W, H)
+        write_pfm(f"{args.parts_prefix}.spp.pfm", np.repeat(nsamp[:, None].astype(np.float64), 3, axis=1), W, H)
+    stats["scene"] = os.path.basename(args.scene)
+    stats["size"] = [W, H]
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(stats, f, indent=1)
     log("stats: " + json.dumps(stats))
     return 0
 
