@@ -1,7 +1,7 @@
 //! The desktop simulator: watch a device render on the desktop.
 //!
-//! Builds the scene in code exactly as the Cortex-M4 firmware does
-//! ([`caustic::demo::fig6`] with [`caustic::demo::device_settings`]: 2 048 photons,
+//! Builds the scene in code exactly as the device firmware does
+//! ([`caustic::demo::fig6`] with [`caustic::budget::FIG6`]: 2 048 photons,
 //! K = 32, path stack of 8, seed 0, [`ToneMap::default`], no dithering), renders it row
 //! by row through the library's `DrawTarget` adapter ([`DisplaySink`]) onto an
 //! `embedded-graphics-simulator` [`SimulatorDisplay`] of the device's 160×120 RGB565
@@ -59,7 +59,6 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use caustic::demo;
 use caustic::desktop::cli::PhotonArgs;
 use caustic::desktop::settings::{Given, SettingsInput};
 use caustic::desktop::{self, MAX_DEPTH, MAX_GATHER, MAX_LIGHTS, MAX_OBJECTS};
@@ -68,6 +67,7 @@ use caustic::photon::{self, KdTree, Photon, PhotonSettings};
 use caustic::raster::{DisplaySink, Dither, ToneMap};
 use caustic::render::Renderer;
 use caustic::scene::Scene;
+use caustic::{budget, demo};
 use clap::error::ErrorKind;
 use clap::{Parser, ValueEnum};
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -76,13 +76,13 @@ use embedded_graphics_core::pixelcolor::{BinaryColor, PixelColor, Rgb565, Rgb888
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay, Window};
 
 /// Gather capacity K of the device build.
-pub const DEVICE_GATHER: usize = demo::DEVICE_K as usize;
+pub const DEVICE_GATHER: usize = budget::FIG6.k;
 /// Path stack DEPTH of the device build.
-pub const DEVICE_DEPTH: usize = demo::DEVICE_MAX_DEPTH as usize;
+pub const DEVICE_DEPTH: usize = budget::FIG6.depth;
 /// Objects of the device build's scene type.
-pub const DEVICE_OBJECTS: usize = 2;
+pub const DEVICE_OBJECTS: usize = budget::FIG6_OBJECTS;
 /// Lights of the device build's scene type.
-pub const DEVICE_LIGHTS: usize = 1;
+pub const DEVICE_LIGHTS: usize = budget::FIG6_LIGHTS;
 
 /// The display's colour format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -210,7 +210,7 @@ where
     match &opts.scene {
         None => {
             let scene = demo::fig6::<DEVICE_OBJECTS, DEVICE_LIGHTS>(opts.width, opts.height)?;
-            let device = SettingsInput::of(&demo::device_settings()?);
+            let device = SettingsInput::of(&budget::FIG6.settings()?);
             let input = device.overridden_by(&opts.budget.input());
             let settings = opts.budget.finish(input.validate(&scene)?.photons);
             draw::<_, DEVICE_OBJECTS, DEVICE_LIGHTS, DEVICE_GATHER, DEVICE_DEPTH>(
@@ -277,7 +277,8 @@ where
         .into());
     }
     let mut photons = vec![Photon::ZERO; needed];
-    let forward = photon::shoot(scene, settings, seed, 0, &mut photons)?;
+    let mut splats = Vec::new();
+    let forward = photon::shoot_with_splats(scene, settings, seed, 0, &mut photons, &mut splats)?;
     photons.truncate(forward.stored);
     photon::balance(&mut photons);
     let store = photon::store_over::<K>(
@@ -287,6 +288,13 @@ where
     )?;
     let renderer: Renderer<'_, _, O, L, DEPTH> =
         Renderer::new(scene, &store, settings.max_depth())?;
+    // As the device (`budget::DeviceMap::with_splats`): caustics seen directly are
+    // light-traced when the settings splat.
+    let renderer = if settings.camera_splats() {
+        renderer.with_splats(&splats)
+    } else {
+        renderer
+    };
 
     let mut row = vec![Rgb::ZERO; scene.camera().width() as usize];
     let count = renderer

@@ -2,7 +2,8 @@
 //!
 //! [`fig6`] is the paper's Fig. 6 scene (section 3.3) exactly as `scenes/fig6.json`
 //! describes it (a test checks that they agree), so a device, the desktop simulator and
-//! the desktop renderer draw the same thing.
+//! the desktop renderer draw the same thing. A device's capacities and photon budget
+//! for it are [`crate::budget::FIG6`].
 
 use crate::camera::Camera;
 use crate::error::Error;
@@ -10,17 +11,7 @@ use crate::geometry::Shape;
 use crate::light::PointLight;
 use crate::material::{Classic, Material};
 use crate::math::{Rgb, Vec3};
-use crate::photon::PhotonSettings;
 use crate::scene::Scene;
-
-/// Photons per light of the device build: 2 048 photons, 40 KiB of map.
-pub const DEVICE_PHOTONS: u32 = 2048;
-/// Photons per estimate on the device.
-pub const DEVICE_K: u32 = 32;
-/// Gather radius bound on the device, scene units (the cube's edge is 4).
-pub const DEVICE_MAX_RADIUS: f32 = 1.0;
-/// Specular interactions per path on the device.
-pub const DEVICE_MAX_DEPTH: u32 = 8;
 
 /// The paper's Fig. 6: a transparent green `classic` cube (ambient 0.3, diffuse 0.9,
 /// specular 0.2, reflectivity 0.2, transparency 0.7, ior 1.25), edge 4 at (2, 1, −1),
@@ -67,13 +58,42 @@ pub fn fig6<const O: usize, const L: usize>(width: u32, height: u32) -> Result<S
     Ok(scene)
 }
 
-/// The device's photon settings: [`DEVICE_PHOTONS`], [`DEVICE_K`],
-/// [`DEVICE_MAX_RADIUS`], [`DEVICE_MAX_DEPTH`].
-pub fn device_settings() -> Result<PhotonSettings, Error> {
-    PhotonSettings::new(
-        DEVICE_PHOTONS,
-        DEVICE_K,
-        DEVICE_MAX_RADIUS,
-        DEVICE_MAX_DEPTH,
-    )
+/// A physical scene for devices: a glass sphere (index 1.5, Beer absorption
+/// σ = (0.05, 0.12, 0.3) per unit length: a faint amber tint through its 2-unit
+/// diameter) resting on a grey diffuse floor (albedo 0.8), beside a tilted mirror
+/// (reflectance 0.9, a 2.4 × 1.6 × 0.05 slab) that throws a second, reflected patch of
+/// light, lit by one point light (60 W/sr) and seen from (0, 4, 7) as in
+/// `scenes/glass_sphere.json`. Rendered at `width × height`. Its device budget is
+/// [`crate::budget::GLASS`].
+pub fn glass<const O: usize, const L: usize>(
+    width: u32,
+    height: u32,
+) -> Result<Scene<O, L>, Error> {
+    let camera = Camera::new(
+        Vec3::new(0.0, 4.0, 7.0),
+        Vec3::new(0.0, 0.6, 0.0),
+        Vec3::Y,
+        40.0,
+        width,
+        height,
+    )?;
+    let mut scene = Scene::new(camera);
+    scene.add_light(PointLight::new(
+        Vec3::new(-3.0, 6.0, -2.0),
+        Rgb::splat(60.0),
+    )?)?;
+    let floor = Material::diffuse(Rgb::splat(0.8))?;
+    let glass = Material::dielectric(1.5, Rgb::new(0.05, 0.12, 0.3))?;
+    let mirror = Material::mirror(Rgb::splat(0.9))?;
+    scene.add(Shape::plane(Vec3::ZERO, Vec3::Y)?, floor)?;
+    scene.add(Shape::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0)?, glass)?;
+    scene.add(
+        Shape::cuboid(
+            Vec3::new(2.2, 0.8, -1.5),
+            Vec3::new(2.4, 1.6, 0.05),
+            Vec3::new(0.0, -35.0, 0.0),
+        )?,
+        mirror,
+    )?;
+    Ok(scene)
 }

@@ -67,6 +67,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod budget;
 pub mod camera;
 pub mod demo;
 mod error;

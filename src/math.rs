@@ -77,20 +77,22 @@ pub fn max(a: f32, b: f32) -> f32 {
 /// but a NaN payload.
 #[inline]
 pub fn max_num(a: f32, b: f32) -> f32 {
-    if a.is_nan() || a < b {
-        b
-    } else {
+    // `a ≥ b` decides at once unless `a` is NaN or smaller; then `b`, unless `b` is the
+    // NaN (then `a`): libm's `a.is_nan() || a < b ? b : a`, one comparison first.
+    if a >= b || b.is_nan() {
         a
+    } else {
+        b
     }
 }
 
 /// `f32::min` (`minNum`) as comparisons; see [`max_num`].
 #[inline]
 pub fn min_num(a: f32, b: f32) -> f32 {
-    if a.is_nan() || b < a {
-        b
-    } else {
+    if a <= b || b.is_nan() {
         a
+    } else {
+        b
     }
 }
 
@@ -162,7 +164,8 @@ impl UnitVec3 {
     #[inline]
     pub fn new(v: Vec3) -> Option<Self> {
         let len2 = v.length_squared();
-        if !(len2 > 0.0 && len2 < f32::INFINITY) {
+        // Two float comparisons; LLVM turns `< ∞` into a 16-instruction integer test.
+        if !(len2 > 0.0) || !(len2 <= f32::MAX) {
             return None;
         }
         Some(Self(v * (1.0 / sqrt(len2))))
@@ -441,6 +444,29 @@ mod tests {
             assert!((t.get().length() - 1.0).abs() < 1e-5 && (s.get().length() - 1.0).abs() < 1e-5);
             // Right-handed: t × s = n.
             assert!((t.get().cross(s.get()) - n.get()).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn max_num_and_min_num_are_f32_max_and_min() {
+        let v = [
+            f32::NAN,
+            f32::NEG_INFINITY,
+            -1.5,
+            -0.0,
+            0.0,
+            2.0,
+            f32::INFINITY,
+        ];
+        for a in v {
+            for b in v {
+                let same =
+                    |x: f32, y: f32| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+                // Zeros of either sign are equal, and either may come back.
+                let zeros = a == 0.0 && b == 0.0;
+                assert!(same(max_num(a, b), a.max(b)) || zeros, "max {a} {b}");
+                assert!(same(min_num(a, b), a.min(b)) || zeros, "min {a} {b}");
+            }
         }
     }
 

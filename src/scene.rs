@@ -24,6 +24,9 @@ pub struct Object {
 pub struct Scene<const OBJECTS: usize, const LIGHTS: usize> {
     camera: Camera,
     objects: FixedVec<Object, OBJECTS>,
+    /// Object indices, bounded shapes first, then planes (each group in scene order):
+    /// the order [`intersect`](Self::intersect) tries them in.
+    order: FixedVec<usize, OBJECTS>,
     lights: FixedVec<PointLight, LIGHTS>,
     background: Rgb,
     ambient: Rgb,
@@ -35,6 +38,7 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
         Self {
             camera,
             objects: FixedVec::new(),
+            order: FixedVec::new(),
             lights: FixedVec::new(),
             background: Rgb::ZERO,
             ambient: Rgb::ZERO,
@@ -43,13 +47,26 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
 
     /// Adds an object; an error when the compiled capacity is full.
     pub fn add(&mut self, shape: Shape, material: Material) -> Result<(), Error> {
+        let index = self.objects.len();
         self.objects
             .push(Object { shape, material })
             .map_err(|_| Error::Capacity {
                 what: "objects",
                 requested: OBJECTS + 1,
                 capacity: OBJECTS,
-            })
+            })?;
+        // Bounded shapes go before the first plane; cannot fail: one entry per object.
+        let at = if shape.is_bounded() {
+            let planes = self
+                .order
+                .iter()
+                .filter(|&&i| !self.objects[i].shape.is_bounded());
+            self.order.len() - planes.count()
+        } else {
+            self.order.len()
+        };
+        let _ = self.order.insert(at, index);
+        Ok(())
     }
 
     /// Adds a light; an error when the compiled capacity is full.
@@ -109,14 +126,30 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
         self.objects.iter().any(|o| o.material.is_specular())
     }
 
-    /// The nearest hit along `ray` with `t < t_max`, and the index of the object hit.
+    /// The nearest hit along `ray` with `t < t_max`, and the index of the object hit
+    /// (on an exact tie, the lower index).
+    ///
+    /// Bounded shapes are tried before unbounded planes: a nearer hit found first
+    /// narrows `t_max`, and a plane hit beyond it is then dismissed after its distance,
+    /// before its point is built (a ray leaving a box towards the floor, the common
+    /// case of a glass object above a plane). Bounded shapes reject cheaply by their
+    /// bounding sphere whatever the order.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(Hit, usize)> {
         let mut best: Option<(Hit, usize)> = None;
+        // The index of `best` (0 without one: then no index is lower).
+        let mut best_index = 0;
         let mut limit = t_max;
-        for (i, o) in self.objects.iter().enumerate() {
-            if let Some(h) = o.shape.intersect(ray, limit) {
+        for &i in &self.order {
+            // A later index must be strictly nearer; an earlier one wins a tie.
+            let reach = if best_index > i {
+                next_up(limit)
+            } else {
+                limit
+            };
+            if let Some(h) = self.objects[i].shape.intersect(ray, reach) {
                 limit = h.t;
+                best_index = i;
                 best = Some((h, i));
             }
         }
@@ -130,6 +163,16 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.objects.iter().any(|o| o.shape.blocks(ray, t_max))
+    }
+}
+
+/// The next `f32` above a positive `x` (`+∞` stays).
+#[inline]
+fn next_up(x: f32) -> f32 {
+    if x < f32::INFINITY {
+        f32::from_bits(x.to_bits() + 1)
+    } else {
+        x
     }
 }
 
@@ -166,6 +209,29 @@ mod tests {
         let r = Ray::new(Vec3::ZERO, UnitVec3::Z);
         let (h, i) = s.intersect(&r, f32::INFINITY).unwrap();
         assert_eq!((h.t, i), (4.0, 1));
+        // Planes are tried after bounded shapes, but the order of the scene decides ties
+        // and the nearest hit wins.
+        let mut t: Scene<3, 1> = Scene::new(cam);
+        t.add(Shape::plane(Vec3::new(0.0, 0.0, 4.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        t.add(Shape::sphere(Vec3::new(0.0, 0.0, 5.0), 1.0).unwrap(), m)
+            .unwrap();
+        t.add(Shape::plane(Vec3::new(0.0, 0.0, 3.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        assert_eq!(
+            t.intersect(&r, f32::INFINITY).map(|(h, i)| (h.t, i)),
+            Some((3.0, 2))
+        );
+        assert_eq!(t.intersect(&r, 3.5).map(|(h, i)| (h.t, i)), Some((3.0, 2)));
+        let mut tie: Scene<2, 1> = Scene::new(cam);
+        tie.add(Shape::plane(Vec3::new(0.0, 0.0, 4.0), -Vec3::Z).unwrap(), m)
+            .unwrap();
+        tie.add(Shape::sphere(Vec3::new(0.0, 0.0, 5.0), 1.0).unwrap(), m)
+            .unwrap();
+        assert_eq!(
+            tie.intersect(&r, f32::INFINITY).map(|(h, i)| (h.t, i)),
+            Some((4.0, 0))
+        );
         assert!(s.occluded(&r, 4.5) && !s.occluded(&r, 3.5));
     }
 }

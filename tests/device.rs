@@ -1,184 +1,150 @@
-//! The Cortex-M4F firmware's image (`examples/cortex-m4`), rendered on the host through
-//! the same path, and compared with the device's bytes bit for bit.
+//! The device firmware's image (`examples/device`), rendered on the host through the
+//! same path, against a committed hash, and against the device's own bytes when
+//! `tools/device/run.sh` hands them over.
 //!
-//! The scene, settings, seed, gather size `K`, path stack `DEPTH`, tone map and dither
-//! are the firmware's; the display is an in-memory RGB565 `DrawTarget` instead of a file
-//! written through semihosting. `tools/device/run.sh` runs the firmware under QEMU and
-//! then this test with
-//! - `CAUSTIC_DEVICE_RGB565`: the device's file (little-endian RGB565, row-major);
-//! - `CAUSTIC_DEVICE_FNV1A`: the hash from the firmware's `PASS` line.
+//! The scene, budget (`caustic::budget::FIG6`), tone map and dither are the
+//! firmware's, and so is the display: the library's `Rgb565Stream`. `run.sh` runs the
+//! firmware under QEMU on four instruction sets, then this test with, per scene
+//! (`FIG6`, `GLASS`),
+//! - `CAUSTIC_DEVICE_<SCENE>_RGB565`: a device's file (little-endian RGB565, row-major);
+//! - `CAUSTIC_DEVICE_<SCENE>_FNV1A`: the hash from the firmware's `PASS` line.
 //!
-//! Without them the comparison is skipped (and said so) and only the host-side
-//! properties are checked. `cargo test --test device -- --nocapture` also prints the
-//! `size_of` values of the device budget.
+//! The committed hash is what every firmware printed (`PASS fnv1a=…`) when it was
+//! last changed: `cargo test` alone therefore checks the host against the device.
+//! `cargo test --test device -- --nocapture` also prints the `size_of` values.
+
+mod support;
 
 use std::mem::size_of;
 
-use caustic::demo;
+use caustic::budget::{DeviceMap, DeviceMemory, FIG6, FIG6_LIGHTS, FIG6_OBJECTS, GLASS};
 use caustic::math::Rgb;
-use caustic::photon::{KdStore, Photon, PhotonMap};
-use caustic::raster::{DisplaySink, Dither, ToneMap};
-use caustic::render::Renderer;
+use caustic::photon::{KdStore, Photon};
+use caustic::raster::Fnv1a;
 use caustic::scene::Scene;
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
-use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
-use embedded_graphics_core::Pixel;
 
-// Mirrors of the firmware's constants (examples/cortex-m4/src/main.rs).
-const WIDTH: u32 = 160;
-const HEIGHT: u32 = 120;
-const SEED: u64 = 0;
-const K: usize = 32;
-const DEPTH: usize = 8;
-const PHOTONS: usize = demo::DEVICE_PHOTONS as usize;
+/// FNV-1a of Fig. 6's RGB565 bytes as the four firmwares (Cortex-M4F, M3, M33,
+/// RV32IMAC) streamed them under QEMU (tools/device/run.sh).
+const FIG6_FNV1A: u32 = 0xc8f3_1be2;
+/// FNV-1a of the glass scene's bytes (`demo::glass`, `budget::GLASS`), as the four
+/// firmwares built with `--features glass` streamed them.
+const GLASS_FNV1A: u32 = 0x3d6c_a526;
 
-/// An RGB565 display in memory, laid out as the device's file; it counts the writes
-/// to each pixel and refuses pixels outside it.
-struct Memory565 {
-    size: Size,
-    bytes: Vec<u8>,
-    writes: Vec<u32>,
-}
-
-impl Memory565 {
-    fn new(width: u32, height: u32) -> Self {
-        let n = (width * height) as usize;
-        Self {
-            size: Size::new(width, height),
-            bytes: vec![0; 2 * n],
-            writes: vec![0; n],
-        }
+/// Checks a host stream of scene `tag` (`FIG6`, `GLASS`): rows in order, the
+/// committed hash, and, when run.sh hands them over, the device's bytes
+/// (`CAUSTIC_DEVICE_<TAG>_RGB565`) and hash (`CAUSTIC_DEVICE_<TAG>_FNV1A`).
+fn check_against_the_device(tag: &str, s: &support::device::Streamed, height: u32, committed: u32) {
+    assert_eq!(
+        s.rows,
+        (0..height).collect::<Vec<_>>(),
+        "rows top to bottom, once each"
+    );
+    assert_eq!(s.hash, Fnv1a::of(&s.bytes));
+    assert!(s.forward.stored > 0, "caustic photons land");
+    println!(
+        "host {tag}: {} bytes RGB565, {} photons stored of {} emitted, fnv1a=0x{:08x}",
+        s.bytes.len(),
+        s.forward.stored,
+        s.forward.emitted,
+        s.hash
+    );
+    assert_eq!(
+        s.hash, committed,
+        "{tag}: the host render is not the committed device image (if the renderer changed \
+         on purpose, run tools/device/run.sh and commit the hash every firmware prints)"
+    );
+    if let Ok(expected) = std::env::var(format!("CAUSTIC_DEVICE_{tag}_FNV1A")) {
+        let expected = u32::from_str_radix(expected.trim().trim_start_matches("0x"), 16)
+            .expect("the device hash is a hex u32");
+        assert_eq!(
+            s.hash, expected,
+            "{tag}: the host's hash against the firmware's PASS line"
+        );
     }
-}
-
-impl OriginDimensions for Memory565 {
-    fn size(&self) -> Size {
-        self.size
+    let Some(path) = std::env::var_os(format!("CAUSTIC_DEVICE_{tag}_RGB565")) else {
+        println!("{tag}: no device file given: compared with the committed hash only");
+        return;
+    };
+    let device =
+        std::fs::read(&path).unwrap_or_else(|e| panic!("reading {}: {e}", path.to_string_lossy()));
+    assert_eq!(device.len(), s.bytes.len(), "{tag}: device file length");
+    let width = s.bytes.len() / 2 / height as usize;
+    let differing: Vec<usize> = (0..s.bytes.len() / 2)
+        .filter(|&i| device[2 * i..2 * i + 2] != s.bytes[2 * i..2 * i + 2])
+        .collect();
+    if let Some(&i) = differing.first() {
+        let px = |b: &[u8]| u16::from_le_bytes([b[2 * i], b[2 * i + 1]]);
+        panic!(
+            "{tag}: {} of {} pixels differ; first at ({}, {}): device {:#06x}, host {:#06x}",
+            differing.len(),
+            s.bytes.len() / 2,
+            i % width,
+            i / width,
+            px(&device),
+            px(&s.bytes),
+        );
     }
-}
-
-impl DrawTarget for Memory565 {
-    type Color = Rgb565;
-    type Error = core::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        let (w, h) = (self.size.width as i32, self.size.height as i32);
-        for Pixel(p, c) in pixels {
-            assert!(
-                (0..w).contains(&p.x) && (0..h).contains(&p.y),
-                "pixel {p:?} outside the {w}x{h} display"
-            );
-            let i = (p.y * w + p.x) as usize;
-            self.bytes[2 * i..2 * i + 2].copy_from_slice(&c.into_storage().to_le_bytes());
-            self.writes[i] += 1;
-        }
-        Ok(())
-    }
-}
-
-/// FNV-1a, 32 bits: the firmware's checksum.
-fn fnv1a(bytes: &[u8]) -> u32 {
-    bytes.iter().fold(0x811c_9dc5u32, |h, &b| {
-        (h ^ b as u32).wrapping_mul(0x0100_0193)
-    })
-}
-
-/// The firmware's render, on the host: RGB565 bytes, rows handed to the sink, and
-/// photons stored.
-fn render_like_the_device() -> (Memory565, Vec<u32>, usize) {
-    let scene = demo::fig6::<2, 1>(WIDTH, HEIGHT).unwrap();
-    let settings = demo::device_settings().unwrap();
-    let mut map: Box<PhotonMap<PHOTONS>> = Box::new(PhotonMap::new());
-    let forward = map.build(&scene, &settings, SEED).unwrap();
-    let store = map.store::<K>(&settings).unwrap();
-    let renderer: Renderer<_, 2, 1, DEPTH> =
-        Renderer::new(&scene, &store, settings.max_depth()).unwrap();
-    let mut display = Memory565::new(WIDTH, HEIGHT);
-    let mut rows = Vec::new();
-    let mut row = [Rgb::ZERO; WIDTH as usize];
-    {
-        let mut sink = DisplaySink::new(&mut display, ToneMap::default(), Dither::Off);
-        renderer
-            .rows(&mut row, |y, pixels| {
-                rows.push(y);
-                sink.draw_row(y, pixels)
-            })
-            .unwrap();
-    }
-    (display, rows, forward.stored)
+    println!(
+        "{tag}: device file {} is bit-identical to the host render ({} bytes)",
+        path.to_string_lossy(),
+        device.len()
+    );
 }
 
 #[test]
 fn device_image_is_the_host_image_bit_for_bit() {
-    let (display, rows, stored) = render_like_the_device();
-    assert_eq!(
-        rows,
-        (0..HEIGHT).collect::<Vec<_>>(),
-        "rows top to bottom, once each"
+    check_against_the_device(
+        "FIG6",
+        &support::device::fig6_stream(),
+        FIG6.height,
+        FIG6_FNV1A,
     );
-    assert!(
-        display.writes.iter().all(|&n| n == 1),
-        "every pixel written exactly once"
-    );
-    assert!(stored > 0, "the cube makes caustic photons");
-    let hash = fnv1a(&display.bytes);
-    println!("host: {WIDTH}x{HEIGHT} RGB565, {stored} photons stored, fnv1a=0x{hash:08x}");
+}
 
-    if let Ok(expected) = std::env::var("CAUSTIC_DEVICE_FNV1A") {
-        let expected = u32::from_str_radix(expected.trim().trim_start_matches("0x"), 16)
-            .expect("CAUSTIC_DEVICE_FNV1A is a hex u32");
-        assert_eq!(
-            hash, expected,
-            "the host's hash against the firmware's PASS line"
-        );
-    }
-    match std::env::var_os("CAUSTIC_DEVICE_RGB565") {
-        None => println!("CAUSTIC_DEVICE_RGB565 not set: skipped the comparison with the device"),
-        Some(path) => {
-            let device = std::fs::read(&path)
-                .unwrap_or_else(|e| panic!("reading {}: {e}", path.to_string_lossy()));
-            assert_eq!(device.len(), display.bytes.len(), "device file length");
-            let differing: Vec<usize> = (0..display.writes.len())
-                .filter(|&i| device[2 * i..2 * i + 2] != display.bytes[2 * i..2 * i + 2])
-                .collect();
-            if let Some(&i) = differing.first() {
-                let px = |b: &[u8]| u16::from_le_bytes([b[2 * i], b[2 * i + 1]]);
-                panic!(
-                    "{} of {} pixels differ; first at ({}, {}): device {:#06x}, host {:#06x}",
-                    differing.len(),
-                    display.writes.len(),
-                    i % WIDTH as usize,
-                    i / WIDTH as usize,
-                    px(&device),
-                    px(&display.bytes),
-                );
-            }
-            println!(
-                "device file {} is bit-identical to the host render ({} bytes)",
-                path.to_string_lossy(),
-                device.len()
-            );
-        }
-    }
+/// The physical scene: a dielectric sphere (Fresnel, Beer absorption), a mirror and a
+/// diffuse floor, with the desktop's default estimator (light-traced caustics where
+/// the eye sees them, gathers behind the glass).
+#[test]
+fn glass_scene_on_the_device_is_the_host_image_bit_for_bit() {
+    let s = support::device::glass_stream();
+    check_against_the_device("GLASS", &s, GLASS.height, GLASS_FNV1A);
+    // Not a blank frame: the floor, the sphere, its caustic and the mirror.
+    let mut colours: Vec<&[u8]> = s.bytes.chunks(2).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 100, "{} colours", colours.len());
 }
 
 #[test]
 fn device_budget_sizes() {
+    type Memory = DeviceMemory<
+        FIG6_OBJECTS,
+        FIG6_LIGHTS,
+        { FIG6.stored },
+        { FIG6.splats },
+        { FIG6.width as usize },
+    >;
     let sizes = [
         ("Photon", size_of::<Photon>()),
-        ("PhotonMap<2048>", size_of::<PhotonMap<PHOTONS>>()),
-        ("Scene<2,1>", size_of::<Scene<2, 1>>()),
-        ("KdStore<32>", size_of::<KdStore<'static, K>>()),
-        ("Rgb row [Rgb; 160]", size_of::<[Rgb; WIDTH as usize]>()),
+        (
+            "DeviceMap<FIG6.stored, FIG6.splats>",
+            size_of::<DeviceMap<{ FIG6.stored }, { FIG6.splats }>>(),
+        ),
+        ("Scene<2,1>", size_of::<Scene<FIG6_OBJECTS, FIG6_LIGHTS>>()),
+        ("KdStore<FIG6.k>", size_of::<KdStore<'static, { FIG6.k }>>()),
+        (
+            "row [Rgb; FIG6.width]",
+            size_of::<[Rgb; FIG6.width as usize]>(),
+        ),
+        ("DeviceMemory (scene + map + row)", size_of::<Memory>()),
     ];
     for (what, bytes) in sizes {
         println!("size_of {what}: {bytes} bytes");
     }
-    assert_eq!(size_of::<Photon>(), 20);
-    // The map is its photons and a few words: it fits the 64 KiB static budget.
-    assert!(size_of::<PhotonMap<PHOTONS>>() <= 20 * PHOTONS + 16);
+    assert_eq!(size_of::<Photon>(), 16);
+    // The map is its photons, its splats and a few words, sized to what is stored, not
+    // to what is emitted.
+    let map = size_of::<DeviceMap<{ FIG6.stored }, { FIG6.splats }>>();
+    assert!(map <= 16 * (FIG6.stored + FIG6.splats) + 32, "{map}");
+    assert!(FIG6.stored < FIG6.emitted as usize / 3);
 }

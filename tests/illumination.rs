@@ -517,42 +517,41 @@ fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     );
 }
 
-/// A photon carries the object it landed on, and the maps splat it there, not onto
-/// whichever surface lies nearest its position: two coincident planes, photons marked
-/// for the second go to the second. The forward pass marks every photon with the
-/// object it landed on.
+/// The forward pass knows the object each photon landed on, and the maps splat it
+/// there, not onto whichever surface lies nearest its position: two coincident planes,
+/// photons marked for the second go to the second.
 #[test]
 fn photons_are_splatted_on_the_object_they_landed_on() {
     let plane = Shape::plane(Vec3::ZERO, Vec3::Y).unwrap();
     let scene = scene_of(&[plane, plane]);
     let photons: Vec<Photon> = (0..10)
-        .map(|i| Photon::new(Vec3::new(0.1 * i as f32, 0.0, 0.3), down(), Rgb::ONE).on_surface(1))
+        .map(|i| Photon::new(Vec3::new(0.1 * i as f32, 0.0, 0.3), down(), Rgb::ONE))
         .collect();
     let mut maps = Maps::new(Vec::new(), 0.1).unwrap().with_trim(0.0).unwrap();
-    let st = maps.build_from_photons(&scene, &photons, 1.0).unwrap();
+    let st = maps
+        .build_with(&scene, |f| {
+            photons.iter().for_each(|p| f(p, Some(1)));
+            1.0
+        })
+        .unwrap();
     assert_eq!(
         (st.splatted_photons, maps.charts(0), maps.charts(1)),
         (10, 0, 1)
     );
     // Unmarked, the nearest surface (the first of two at distance 0) takes them.
-    let unmarked: Vec<Photon> = photons
-        .iter()
-        .map(|p| Photon::new(p.position(), p.direction(), p.power()))
-        .collect();
-    maps.build_from_photons(&scene, &unmarked, 1.0).unwrap();
+    maps.build_from_photons(&scene, &photons, 1.0).unwrap();
     assert_eq!((maps.charts(0), maps.charts(1)), (1, 0));
-    // An index a photon cannot hold stays unknown.
-    assert_eq!(photons[0].on_surface(255).surface(), None);
-    assert_eq!(photons[0].on_surface(254).surface(), Some(254));
 
     let loaded = parse_scene(&scene_text("glass_sphere.json")).unwrap();
     let settings = PhotonSettings::new(2_000, 8, 0.1, 8).unwrap();
     let mut n = 0;
-    for_each_photon(&loaded.scene, &settings, 1, 0, |p| {
+    caustic::photon::forward(&loaded.scene, &settings, 1, 0, |x| {
         // Object 0 is the floor; every photon lands on it (y = 0).
-        assert_eq!(p.surface(), Some(0));
-        assert!(p.position().y.abs() < 1e-5);
+        assert_eq!(x.object, 0);
+        assert!(x.photon.position().y.abs() < 1e-5);
         n += 1;
-    });
+        Ok(())
+    })
+    .unwrap();
     assert!(n > 1000);
 }

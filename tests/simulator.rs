@@ -1,148 +1,28 @@
 //! The desktop simulator (`examples/simulator.rs`) shows exactly what the device shows.
 //!
 //! The example's own code is compiled in here, and its pixels are compared with those
-//! of the firmware's pipeline (`examples/cortex-m4`: a `static` `PhotonMap<2048>`,
-//! `store::<32>`, `Renderer<_, 2, 1, 8>`, seed 0, `ToneMap::default()`, `Dither::Off`,
-//! `DisplaySink` onto a `DrawTarget<Color = Rgb565>` that writes little-endian `u16`s).
+//! of the firmware's pipeline (`examples/device`, every capacity from
+//! `caustic::budget::FIG6`, `DisplaySink` onto the library's `Rgb565Stream`), which
+//! `tests/support` runs on the host.
 #![cfg(feature = "std")]
+
+mod support;
 
 #[path = "../examples/simulator.rs"]
 #[allow(dead_code)]
 mod simulator;
 
-use caustic::demo;
-use caustic::math::Rgb;
-use caustic::photon::PhotonMap;
-use caustic::raster::{DisplaySink, Dither, ToneMap};
-use caustic::render::Renderer;
+use caustic::budget::FIG6;
+use caustic::raster::{Dither, ToneMap};
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Point, Size};
-use embedded_graphics_core::pixelcolor::{IntoStorage, PixelColor, Rgb565, Rgb888, RgbColor};
-use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::pixelcolor::{PixelColor, Rgb565, Rgb888, RgbColor};
 use embedded_graphics_core::Pixel;
 use embedded_graphics_simulator::SimulatorDisplay;
 use simulator::{ColorFormat, Options};
 
-const W: u32 = 160;
-const H: u32 = 120;
-
-/// The firmware's display, in memory: each pixel's little-endian RGB565 `u16` written
-/// at byte `2·(y·W + x)`, clipped to the display, as `HostFile` does. Also records
-/// whether every write continued where the previous one ended (a pure row-by-row
-/// stream, no seeks) and how many pixels were written.
-struct DeviceStream {
-    size: Size,
-    bytes: Vec<u8>,
-    pos: usize,
-    seeks: usize,
-    written: u32,
-}
-
-impl DeviceStream {
-    fn new(size: Size) -> Self {
-        Self {
-            size,
-            bytes: vec![0; 2 * (size.width * size.height) as usize],
-            pos: 0,
-            seeks: 0,
-            written: 0,
-        }
-    }
-
-    fn write_at(&mut self, at: usize, data: &[u8]) {
-        if at != self.pos {
-            self.seeks += 1;
-        }
-        self.bytes[at..at + data.len()].copy_from_slice(data);
-        self.pos = at + data.len();
-        self.written += (data.len() / 2) as u32;
-    }
-}
-
-impl OriginDimensions for DeviceStream {
-    fn size(&self) -> Size {
-        self.size
-    }
-}
-
-impl DrawTarget for DeviceStream {
-    type Color = Rgb565;
-    type Error = core::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        let (w, h) = (self.size.width as i32, self.size.height as i32);
-        for Pixel(p, c) in pixels {
-            if (0..w).contains(&p.x) && (0..h).contains(&p.y) {
-                self.write_at(
-                    2 * (p.y * w + p.x) as usize,
-                    &c.into_storage().to_le_bytes(),
-                );
-            }
-        }
-        Ok(())
-    }
-
-    fn fill_contiguous<I: IntoIterator<Item = Rgb565>>(
-        &mut self,
-        area: &Rectangle,
-        colors: I,
-    ) -> Result<(), Self::Error> {
-        let (w, h) = (self.size.width as i32, self.size.height as i32);
-        let mut colors = colors.into_iter();
-        let x0 = area.top_left.x;
-        for y in area.top_left.y..area.top_left.y + area.size.height as i32 {
-            let (lo, hi) = (x0.max(0), (x0 + area.size.width as i32).min(w));
-            let visible = (0..h).contains(&y) && lo < hi;
-            let mut row = Vec::new();
-            for x in x0..x0 + area.size.width as i32 {
-                let Some(c) = colors.next() else { break };
-                if visible && (lo..hi).contains(&x) {
-                    row.extend_from_slice(&c.into_storage().to_le_bytes());
-                }
-            }
-            if !row.is_empty() {
-                self.write_at(2 * (y * w + lo) as usize, &row);
-            }
-        }
-        Ok(())
-    }
-}
-
-/// FNV-1a of the byte stream, as the firmware prints it (`PASS fnv1a=0x…`).
-fn fnv1a(bytes: &[u8]) -> u32 {
-    bytes.iter().fold(0x811c_9dc5, |h, &b| {
-        (h ^ b as u32).wrapping_mul(0x0100_0193)
-    })
-}
-
-/// The firmware's pipeline, step by step, calling `sink(y, row)` for each row.
-fn device_rows(mut sink: impl FnMut(u32, &[Rgb])) {
-    let scene = demo::fig6::<2, 1>(W, H).unwrap();
-    let settings = demo::device_settings().unwrap();
-    let mut map: Box<PhotonMap<{ demo::DEVICE_PHOTONS as usize }>> = Box::default();
-    map.build(&scene, &settings, 0).unwrap();
-    let store = map.store::<32>(&settings).unwrap();
-    let renderer: Renderer<_, 2, 1, 8> =
-        Renderer::new(&scene, &store, settings.max_depth()).unwrap();
-    let mut row = [Rgb::ZERO; W as usize];
-    renderer
-        .rows(&mut row, |y, pixels| {
-            sink(y, pixels);
-            Ok::<_, ()>(())
-        })
-        .unwrap();
-}
-
-/// The firmware's byte stream.
-fn device_bytes() -> DeviceStream {
-    let mut display = DeviceStream::new(Size::new(W, H));
-    let mut sink = DisplaySink::new(&mut display, ToneMap::default(), Dither::Off);
-    device_rows(|y, pixels| sink.draw_row(y, pixels).unwrap());
-    display
-}
+const W: u32 = FIG6.width;
+const H: u32 = FIG6.height;
 
 /// The simulator's display after rendering `opts`; also checks that `after_row` saw
 /// each row once, top to bottom.
@@ -228,22 +108,25 @@ fn defaults_are_the_device() {
 /// The headline: the simulator's RGB565 pixels are the device's byte stream, bit for bit.
 #[test]
 fn simulator_shows_exactly_what_the_device_streams() {
-    let device = device_bytes();
-    assert_eq!(device.written, W * H, "every pixel written once");
-    assert_eq!(device.seeks, 0, "rows arrive in order as one stream");
-    println!("device stream fnv1a=0x{:08x}", fnv1a(&device.bytes));
+    // The stream refuses pixels out of order: completing it means one pass, in order.
+    let support::device::Streamed {
+        bytes: device,
+        hash,
+        ..
+    } = support::device::fig6_stream();
+    println!("device stream fnv1a=0x{hash:08x}");
 
     let display = simulate::<Rgb565>(&Options::default());
     let shown = display.to_le_bytes();
-    assert_eq!(shown.len(), device.bytes.len());
-    if let Some(i) = shown.iter().zip(&device.bytes).position(|(a, b)| a != b) {
+    assert_eq!(shown.len(), device.len());
+    if let Some(i) = shown.iter().zip(&device).position(|(a, b)| a != b) {
         let p = i / 2;
         panic!(
             "pixel ({}, {}) differs: simulator {:02x?}, device {:02x?}",
             p % W as usize,
             p / W as usize,
             &shown[2 * p..2 * p + 2],
-            &device.bytes[2 * p..2 * p + 2]
+            &device[2 * p..2 * p + 2]
         );
     }
     // Not a blank frame: the cube, its caustic and the grey field are all there.
@@ -308,7 +191,7 @@ fn every_pixel_is_drawn_exactly_once() {
 fn rgb888_is_the_tone_mapped_srgb_of_the_rows() {
     let tone = ToneMap::default();
     let mut want = Vec::new();
-    device_rows(|_, row| want.extend(row.iter().map(|&c| tone.srgb8(c))));
+    support::device::fig6_rows(|_, row| want.extend(row.iter().map(|&c| tone.srgb8(c))));
     let opts = Options {
         color: ColorFormat::Rgb888,
         ..Options::default()
@@ -413,8 +296,10 @@ fn photons_flag_keeps_the_scenes_gather() {
         v["photons"]["count"] = 20_000.into();
         v["photons"]["gather"] = "nearest".into();
     });
+    // Without camera splats the store gathers at every diffuse hit, so the gather
+    // choice shows wherever the caustic is (with them, only behind the glass).
     let show = |args: &[&str]| {
-        let mut all = vec!["--width", "64", "--height", "48", "--scene"];
+        let mut all = vec!["--width", "64", "--height", "48", "--no-splat", "--scene"];
         all.extend_from_slice(args);
         let opts = Options::parse(all.iter().map(|s| s.to_string()))
             .unwrap()

@@ -2,7 +2,7 @@
 
 use super::{error_bound, BoundingSphere, Hit, Ray};
 use crate::error::{positive, Error};
-use crate::math::{finite_vec, max_abs, Mat3, UnitVec3, Vec3};
+use crate::math::{finite_vec, max_abs, sin_cos_turns, Mat3, UnitVec3, Vec3};
 
 /// A box of full edge lengths `size`, rotated about its centre by `rotation_deg`
 /// (degrees, applied about X, then Y, then Z: `R = Rz·Ry·Rx`).
@@ -31,9 +31,8 @@ impl Cuboid {
         for s in size.to_array() {
             positive(s, "box size")?;
         }
-        let r = finite_vec(rotation_deg, "box rotation_deg")? * (core::f32::consts::PI / 180.0);
-        let rotation =
-            Mat3::from_rotation_z(r.z) * Mat3::from_rotation_y(r.y) * Mat3::from_rotation_x(r.x);
+        let turns = finite_vec(rotation_deg, "box rotation_deg")? * (1.0 / 360.0);
+        let rotation = rotation_zyx(turns);
         let half = size * 0.5;
         let error = error_bound(max_abs(center) + half.length());
         let reject_r = half.length() * (1.0 + 1e-4) + error;
@@ -100,31 +99,17 @@ impl Cuboid {
     #[inline]
     fn slabs(&self, o: [f32; 3], d: [f32; 3]) -> Option<(f32, usize, f32, usize)> {
         let half = self.half.to_array();
-        let (mut t_near, mut t_far) = (f32::NEG_INFINITY, f32::INFINITY);
-        let (mut near_axis, mut far_axis) = (0usize, 0usize);
-        for i in 0..3 {
-            let (oi, di, hi) = (o[i], d[i], half[i]);
-            if di == 0.0 {
-                if oi < -hi || oi > hi {
-                    return None;
-                }
-                continue;
-            }
-            let inv = 1.0 / di;
-            let (mut ta, mut tb) = ((-hi - oi) * inv, (hi - oi) * inv);
-            if ta > tb {
-                core::mem::swap(&mut ta, &mut tb);
-            }
-            if ta > t_near {
-                t_near = ta;
-                near_axis = i;
-            }
-            if tb < t_far {
-                t_far = tb;
-                far_axis = i;
-            }
-        }
-        (t_near <= t_far).then_some((t_near, near_axis, t_far, far_axis))
+        let mut s = Slabs {
+            t_near: f32::NEG_INFINITY,
+            near_axis: 0,
+            t_far: f32::INFINITY,
+            far_axis: 0,
+        };
+        // Unrolled by hand: a loop over an index keeps its bounds checks on Armv7-M.
+        let inside = s.axis(0, o[0], d[0], half[0])
+            && s.axis(1, o[1], d[1], half[1])
+            && s.axis(2, o[2], d[2], half[2]);
+        (inside && s.t_near <= s.t_far).then_some((s.t_near, s.near_axis, s.t_far, s.far_axis))
     }
 
     /// The ray in the box's frame: origin and direction.
@@ -154,11 +139,10 @@ impl Cuboid {
             return None;
         }
         let half = self.half.to_array();
-        let mut local = [0.0f32; 3];
-        for i in 0..3 {
-            // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
-            local[i] = crate::math::clamp(o[i] + d[i] * t, -half[i], half[i]);
-        }
+        // Clamped by comparisons: `Vec3::clamp` is six `fmaxf`/`fminf` calls on Armv7-M.
+        let clamp = |i: usize| crate::math::clamp(o[i] + d[i] * t, -half[i], half[i]);
+        let mut local = [clamp(0), clamp(1), clamp(2)];
+        let axis = axis.min(2); // always: the index of a slab; lets the compiler drop checks
         local[axis] = sign * half[axis];
         let point = self.center + self.rotation * Vec3::from_array(local);
         let normal = self.normals[axis][(sign > 0.0) as usize];
@@ -186,6 +170,54 @@ impl Cuboid {
         let t = if t_near > 0.0 { t_near } else { t_far };
         t > 0.0 && t < t_max
     }
+}
+
+/// The slab method's running interval: entry and exit distance, and the axes of the
+/// faces they lie on.
+struct Slabs {
+    t_near: f32,
+    near_axis: usize,
+    t_far: f32,
+    far_axis: usize,
+}
+
+impl Slabs {
+    /// Narrows the interval by the slab `|o + t·d| ≤ h` of `axis`; `false` when the ray
+    /// runs parallel to it outside (a zero component is handled apart, so that a ray
+    /// lying in a face plane never produces `0·∞ = NaN`).
+    #[inline(always)]
+    fn axis(&mut self, axis: usize, o: f32, d: f32, h: f32) -> bool {
+        if d == 0.0 {
+            return !(o < -h || o > h);
+        }
+        let inv = 1.0 / d;
+        let (mut ta, mut tb) = ((-h - o) * inv, (h - o) * inv);
+        if ta > tb {
+            core::mem::swap(&mut ta, &mut tb);
+        }
+        if ta > self.t_near {
+            self.t_near = ta;
+            self.near_axis = axis;
+        }
+        if tb < self.t_far {
+            self.t_far = tb;
+            self.far_axis = axis;
+        }
+        true
+    }
+}
+
+/// `R = Rz·Ry·Rx` for angles given in turns, with [`sin_cos_turns`]: single
+/// precision only (glam's rotations call `libm::sincosf`, whose `f64` kernels are
+/// 3 KiB of flash and soft-float on a device), and exact at quarter turns.
+fn rotation_zyx(turns: Vec3) -> Mat3 {
+    let (sx, cx) = sin_cos_turns(turns.x);
+    let (sy, cy) = sin_cos_turns(turns.y);
+    let (sz, cz) = sin_cos_turns(turns.z);
+    let rx = Mat3::from_cols(Vec3::X, Vec3::new(0.0, cx, sx), Vec3::new(0.0, -sx, cx));
+    let ry = Mat3::from_cols(Vec3::new(cy, 0.0, -sy), Vec3::Y, Vec3::new(sy, 0.0, cy));
+    let rz = Mat3::from_cols(Vec3::new(cz, sz, 0.0), Vec3::new(-sz, cz, 0.0), Vec3::Z);
+    rz * ry * rx
 }
 
 #[cfg(test)]
@@ -292,6 +324,24 @@ mod tests {
                     }
                     (None, Some(bt)) => panic!("{i},{j}: missed a box the march enters at {bt}"),
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn rotation_is_glams_to_a_few_ulps() {
+        for deg in [
+            Vec3::new(0.0, 30.0, 0.0),
+            Vec3::new(10.0, 20.0, 30.0),
+            Vec3::new(-45.0, 400.0, 90.0),
+        ] {
+            let r = deg * (core::f32::consts::PI / 180.0);
+            let glam = Mat3::from_rotation_z(r.z)
+                * Mat3::from_rotation_y(r.y)
+                * Mat3::from_rotation_x(r.x);
+            let ours = rotation_zyx(deg * (1.0 / 360.0));
+            for (a, b) in ours.to_cols_array().into_iter().zip(glam.to_cols_array()) {
+                assert!((a - b).abs() < 1e-6, "{deg}: {a} {b}");
             }
         }
     }

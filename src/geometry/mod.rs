@@ -166,6 +166,12 @@ impl Shape {
         }
     }
 
+    /// `false` for the unbounded plane.
+    #[inline]
+    pub fn is_bounded(&self) -> bool {
+        !matches!(self, Shape::Plane(_))
+    }
+
     /// A sphere containing the shape; `None` for the unbounded plane.
     pub fn bounding_sphere(&self) -> Option<BoundingSphere> {
         match self {

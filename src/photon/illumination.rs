@@ -70,7 +70,7 @@ use core::f32::consts::PI;
 use heapless::Vec as FixedVec;
 
 use self::chart::{bounded_grids, pair, Grid, Profile};
-use super::{for_each_photon, CausticStore, ForwardStats, Photon, PhotonSettings};
+use super::{forward, CausticStore, ForwardStats, Photon, PhotonSettings};
 use crate::error::{positive, Error};
 use crate::geometry::{Shape, SurfacePoint};
 use crate::material::Classic;
@@ -317,12 +317,17 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         settings: &PhotonSettings,
         seed: u64,
     ) -> Result<(ForwardStats, MapStats), Error> {
-        let mut forward = ForwardStats::default();
-        let stats = self.build_with(scene, |f| {
-            forward = for_each_photon(scene, settings, seed, 0, |p| f(p));
-            forward.power_unit
+        let mut stats = ForwardStats::default();
+        let settings = settings.with_camera_splats(false);
+        let maps = self.build_with(scene, |f| {
+            stats = forward(scene, &settings, seed, 0, |x| {
+                f(&x.photon, Some(x.object));
+                Ok(())
+            })
+            .unwrap_or_default();
+            stats.power_unit
         })?;
-        Ok((forward, stats))
+        Ok((stats, maps))
     }
 
     /// Builds the maps from stored photons whose powers are in units of `unit` W.
@@ -333,21 +338,23 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         unit: f32,
     ) -> Result<MapStats, Error> {
         self.build_with(scene, |f| {
-            photons.iter().for_each(&mut *f);
+            photons.iter().for_each(|p| f(p, None));
             unit
         })
     }
 
     /// Builds the maps from a photon source that `replay` runs in full, in the same
-    /// order every time, and that returns the power unit (W) of the photons.
+    /// order every time, and that returns the power unit (W) of the photons. Each
+    /// photon comes with the index of the object it landed on, when the source knows it
+    /// (else the mapped surface nearest its position takes it).
     pub fn build_with<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
-        mut replay: impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
+        mut replay: impl FnMut(&mut dyn FnMut(&Photon, Option<usize>)) -> f32,
     ) -> Result<MapStats, Error> {
         self.reset(scene)?;
         // Pass 1: which objects receive photons, and the planes' photon rectangles.
-        replay(&mut |p: &Photon| self.survey(p));
+        replay(&mut |p: &Photon, o: Option<usize>| self.survey(p, o));
         // Pass 2 per plane: trim the outliers off its rectangle.
         if self.trim > 0.0 {
             for k in 0..self.objects.len() {
@@ -370,8 +377,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         let mut splatted = Rgb::ZERO;
         let mut dropped = Rgb::ZERO;
         let (mut n_in, mut n_out) = (0u64, 0u64);
-        let unit = replay(&mut |p: &Photon| {
-            if self.splat(p) {
+        let unit = replay(&mut |p: &Photon, o: Option<usize>| {
+            if self.splat(p, o) {
                 splatted += p.power();
                 n_in += 1;
             } else {
@@ -417,8 +424,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// Layout pass: counts a front-side photon on its object and widens a plane's
     /// rectangle to it (a photon whose `(u, v)` overflows is left to be dropped).
-    fn survey(&mut self, p: &Photon) {
-        let Some((k, at)) = self.landing(p) else {
+    fn survey(&mut self, p: &Photon, object: Option<usize>) {
+        let Some((k, at)) = self.landing(p, object) else {
             return;
         };
         if !(at.normal.dot(p.direction().get()) < 0.0) {
@@ -553,7 +560,7 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
     fn trimmed(
         &self,
         k: usize,
-        replay: &mut impl FnMut(&mut dyn FnMut(&Photon)) -> f32,
+        replay: &mut impl FnMut(&mut dyn FnMut(&Photon, Option<usize>)) -> f32,
     ) -> ([f32; 2], [f32; 2]) {
         let m = self.objects[k];
         let cut = (self.trim as f64 * m.photons as f64) as u32;
@@ -562,8 +569,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         let mut beyond = [[0u32; 2]; 2];
         for _round in 0..2 {
             let mut hist = [[[0u32; TRIM_BINS]; 2]; 2];
-            replay(&mut |p: &Photon| {
-                if let Some((j, at)) = self.landing(p) {
+            replay(&mut |p: &Photon, o: Option<usize>| {
+                if let Some((j, at)) = self.landing(p, o) {
                     if j == k && at.normal.dot(p.direction().get()) < 0.0 {
                         for a in 0..2 {
                             let x = [at.u, at.v][a];
@@ -628,12 +635,12 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         Some((k, self.objects[k].shape.locate(x, n)))
     }
 
-    /// The slot of the object photon `p` landed on, and where on it: the object the
-    /// forward pass marked it with ([`Photon::surface`]), else (a photon made
-    /// elsewhere) the mapped object nearest to its position.
+    /// The slot of the object photon `p` landed on, and where on it: `object`, the
+    /// object the forward pass saw it land on, else (a photon from an array) the mapped
+    /// object nearest to its position.
     #[inline]
-    fn landing(&self, p: &Photon) -> Option<(usize, SurfacePoint)> {
-        let Some(object) = p.surface() else {
+    fn landing(&self, p: &Photon, object: Option<usize>) -> Option<(usize, SurfacePoint)> {
+        let Some(object) = object else {
             return self.find(p.position(), None);
         };
         let k = self.objects.iter().position(|m| m.object == object)?;
@@ -643,8 +650,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
     /// Splats photon `p`'s power (any unit) into the four texels around it: first
     /// between the two texel rows around it, then along each row. `false` (nothing
     /// splatted) when it arrived from behind, or lies on no chart.
-    fn splat(&mut self, p: &Photon) -> bool {
-        let Some((k, at)) = self.landing(p) else {
+    fn splat(&mut self, p: &Photon, object: Option<usize>) -> bool {
+        let Some((k, at)) = self.landing(p, object) else {
             return false;
         };
         let power = p.power();

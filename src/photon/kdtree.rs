@@ -19,7 +19,7 @@
 //! child first, and visit the far child only when the splitting plane is closer than
 //! the current search radius.
 
-use super::packed::{Photon, AXIS_MASK, SCRATCH};
+use super::packed::Photon;
 use crate::math::Vec3;
 
 /// The deepest tree a `u32`-indexed array can hold.
@@ -141,8 +141,7 @@ fn partition_slice(
             range
                 .select_nth_unstable_by(mid - t.lo, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
         }
-        let node = &mut photons[mid - base];
-        node.flags = (node.flags & !AXIS_MASK) | axis as u8;
+        photons[mid - base].set_axis(axis);
         // Right first, so that the left subtree is processed next: the stack then holds
         // at most one pending right subtree per level.
         if mid + 1 < t.hi {
@@ -186,7 +185,7 @@ fn longest_axis(photons: &[Photon]) -> usize {
 fn permute_to_heap(photons: &mut [Photon]) {
     let n = photons.len();
     for start in 0..n {
-        if photons[start].flags & SCRATCH != 0 {
+        if photons[start].scratch() {
             continue;
         }
         let held = photons[start];
@@ -195,16 +194,16 @@ fn permute_to_heap(photons: &mut [Photon]) {
             let src = inorder_index(slot + 1, n);
             if src == start {
                 photons[slot] = held;
-                photons[slot].flags |= SCRATCH;
+                photons[slot].set_scratch(true);
                 break;
             }
             photons[slot] = photons[src];
-            photons[slot].flags |= SCRATCH;
+            photons[slot].set_scratch(true);
             slot = src;
         }
     }
     for p in photons.iter_mut() {
-        p.flags &= !SCRATCH;
+        p.set_scratch(false);
     }
 }
 

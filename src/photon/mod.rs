@@ -372,8 +372,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 landing.hit.point,
                 landing.dir,
                 landing.power * (1.0 / self.unit),
-            )
-            .on_surface(landing.object),
+            ),
+            object: landing.object,
             splat,
         })
     }
@@ -385,6 +385,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
 pub struct Landed {
     /// The photon for the caustic store.
     pub photon: Photon,
+    /// Index of the scene object it landed on.
+    pub object: usize,
     /// Its light-tracing contribution to the pixel it projects into.
     pub splat: Option<Splat>,
 }

@@ -1,15 +1,19 @@
-//! The compact photon: 20 bytes.
+//! The compact photon: 16 bytes, four 32-bit words.
 //!
-//! | bytes | field | encoding |
+//! | word | bits 31–7 | bits 6–0 |
 //! |---|---|---|
-//! | 12 | position | three `f32` |
-//! | 4 | power | shared-exponent RGB (Ward's RGBE), relative to the map's power unit |
-//! | 2 | direction of travel | octahedral map, 8 bits per coordinate (Cigolle et al. 2014) |
-//! | 1 | flags | bits 0–1: the kd-tree split axis; bit 7: scratch for balancing |
-//! | 1 | surface | 1 + the index of the scene object it landed on; 0: unknown |
+//! | 0 | position x: `f32` rounded to 16 mantissa bits | direction bits 0–6 |
+//! | 1 | position y, likewise | direction bits 7–13 |
+//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), balancing scratch (1 bit), 2 spare |
+//! | 3 | power: shared-exponent RGB (Ward's RGBE), relative to the map's power unit | |
 //!
-//! The power is stored relative to a per-map unit (the nominal photon power), so the
-//! common photon of exactly nominal power is encoded without rounding.
+//! The direction of travel is an octahedral map, 8 bits per coordinate (Cigolle et
+//! al. 2014). The position keeps 17 significant bits (relative error ≤ 2⁻¹⁷ ≈ 7.6·10⁻⁶,
+//! rounded to nearest): at 10 scene units from the origin 8·10⁻⁵, far below any gather
+//! radius; its low 7 bits carry the rest, so each coordinate reads as one mask. The
+//! power is stored relative to a per-map unit (the nominal photon power), so the common
+//! photon of exactly nominal power is encoded without rounding. (Jensen's photon was
+//! 20 bytes: three floats, RGBE, two angle bytes and a flag short.)
 
 use crate::math::{Rgb, UnitVec3, Vec3};
 
@@ -17,87 +21,98 @@ use crate::math::{Rgb, UnitVec3, Vec3};
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub struct Photon {
-    pos: [f32; 3],
-    rgbe: [u8; 4],
-    dir: [u8; 2],
-    pub(crate) flags: u8,
-    surface: u8,
+    words: [u32; 4],
 }
 
-const _: () = assert!(core::mem::size_of::<Photon>() == 20);
+const _: () = assert!(core::mem::size_of::<Photon>() == 16);
 
-pub(crate) const AXIS_MASK: u8 = 0b11;
-pub(crate) const SCRATCH: u8 = 0x80;
+/// The low bits of a position word that carry other fields.
+const PAYLOAD: u32 = 0x7f;
+/// Where the axis sits in word 2's payload.
+const AXIS_SHIFT: u32 = 2;
+const AXIS_BITS: u32 = 0b11 << AXIS_SHIFT;
+const SCRATCH_BIT: u32 = 1 << 4;
+
+/// `x` rounded to nearest at bit 7 of its pattern (a carry into the exponent is the
+/// correct rounding); truncated instead where rounding would overflow to infinity.
+#[inline]
+fn round_position(x: f32) -> u32 {
+    const HALF: u32 = (PAYLOAD + 1) >> 1;
+    let rounded = (x.to_bits() + HALF) & !PAYLOAD;
+    if f32::from_bits(rounded).is_finite() {
+        rounded
+    } else {
+        x.to_bits() & !PAYLOAD
+    }
+}
 
 impl Photon {
     /// A photon at `pos` travelling along `dir` with `power` in units of the map's unit.
     pub fn new(pos: Vec3, dir: UnitVec3, power: Rgb) -> Self {
+        let d = u16::from_le_bytes(encode_octahedral(dir)) as u32;
         Self {
-            pos: pos.to_array(),
-            rgbe: encode_rgbe(power),
-            dir: encode_octahedral(dir),
-            flags: 0,
-            surface: 0,
+            words: [
+                round_position(pos.x) | (d & PAYLOAD),
+                round_position(pos.y) | ((d >> 7) & PAYLOAD),
+                round_position(pos.z) | (d >> 14),
+                u32::from_le_bytes(encode_rgbe(power)),
+            ],
         }
-    }
-
-    /// The same photon, marked as landed on scene object `object` (an index of 255 or
-    /// more is left unknown): the illumination maps then need not find its surface
-    /// again from its position.
-    pub fn on_surface(mut self, object: usize) -> Self {
-        self.surface = if object < u8::MAX as usize {
-            object as u8 + 1
-        } else {
-            0
-        };
-        self
-    }
-
-    /// The scene object it landed on, when known (see [`on_surface`](Self::on_surface)).
-    #[inline]
-    pub fn surface(&self) -> Option<usize> {
-        (self.surface > 0).then(|| self.surface as usize - 1)
     }
 
     /// An all-zero photon (const, for static arrays).
     pub(crate) const fn zeroed() -> Self {
-        Self {
-            pos: [0.0; 3],
-            rgbe: [0; 4],
-            dir: [0; 2],
-            flags: 0,
-            surface: 0,
-        }
+        Self { words: [0; 4] }
     }
 
     /// Where it landed.
     #[inline]
     pub fn position(&self) -> Vec3 {
-        Vec3::from_array(self.pos)
+        Vec3::new(self.coord(0), self.coord(1), self.coord(2))
     }
 
     /// One coordinate of the position.
     #[inline]
     pub(crate) fn coord(&self, axis: usize) -> f32 {
-        self.pos[axis]
+        f32::from_bits(self.words[axis] & !PAYLOAD)
     }
 
     /// Its power, in units of the map's power unit.
     #[inline]
     pub fn power(&self) -> Rgb {
-        decode_rgbe(self.rgbe)
+        decode_rgbe(self.words[3].to_le_bytes())
     }
 
     /// Its direction of travel when it landed (decoded to within about 1°).
     #[inline]
     pub fn direction(&self) -> UnitVec3 {
-        decode_octahedral(self.dir)
+        let [a, b, c, _] = self.words;
+        let d = (a & PAYLOAD) | ((b & PAYLOAD) << 7) | ((c & 0b11) << 14);
+        decode_octahedral((d as u16).to_le_bytes())
     }
 
     /// The kd-tree split axis of this node (0, 1, 2).
     #[inline]
     pub(crate) fn axis(&self) -> usize {
-        (self.flags & AXIS_MASK) as usize
+        ((self.words[2] & AXIS_BITS) >> AXIS_SHIFT) as usize
+    }
+
+    /// Sets the kd-tree split axis (0, 1, 2).
+    #[inline]
+    pub(crate) fn set_axis(&mut self, axis: usize) {
+        self.words[2] = (self.words[2] & !AXIS_BITS) | ((axis as u32) << AXIS_SHIFT);
+    }
+
+    /// The balancing pass's mark.
+    #[inline]
+    pub(crate) fn scratch(&self) -> bool {
+        self.words[2] & SCRATCH_BIT != 0
+    }
+
+    /// Sets or clears the balancing pass's mark.
+    #[inline]
+    pub(crate) fn set_scratch(&mut self, on: bool) {
+        self.words[2] = (self.words[2] & !SCRATCH_BIT) | if on { SCRATCH_BIT } else { 0 };
     }
 }
 
@@ -189,6 +204,34 @@ mod tests {
             Rgb::new(0.5, 0.25, 1.0)
         );
         assert_eq!(decode_rgbe(encode_rgbe(Rgb::ZERO)), Rgb::ZERO);
+    }
+
+    #[test]
+    fn fields_survive_packing_and_the_position_keeps_17_bits() {
+        let mut g = Pcg32::new(9);
+        for i in 0..5_000 {
+            let pos = Vec3::new(g.next_f32() - 0.5, g.next_f32(), g.next_f32() + 3.0)
+                * [1e-3, 1.0, 40.0, 1e5][i % 4];
+            let dir = UnitVec3::new(Vec3::new(
+                g.next_f32() - 0.5,
+                g.next_f32() - 0.5,
+                g.next_f32() - 0.5,
+            ))
+            .unwrap();
+            let power = Rgb::new(g.next_f32(), g.next_f32(), 2.0);
+            let mut p = Photon::new(pos, dir, power);
+            for axis in [2, 0, 1] {
+                p.set_axis(axis);
+                p.set_scratch(axis == 0);
+                assert_eq!((p.axis(), p.scratch()), (axis, axis == 0));
+                assert_eq!(p.direction(), decode_octahedral(encode_octahedral(dir)));
+                assert_eq!(p.power(), decode_rgbe(encode_rgbe(power)));
+                for k in 0..3 {
+                    let (a, b) = (p.position()[k], pos[k]);
+                    assert!((a - b).abs() <= b.abs() * libm::ldexpf(1.0, -17), "{a} {b}");
+                }
+            }
+        }
     }
 
     #[test]

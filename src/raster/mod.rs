@@ -5,10 +5,14 @@
 #[cfg(feature = "embedded-graphics")]
 mod display;
 mod srgb_table;
+#[cfg(feature = "embedded-graphics")]
+mod stream;
 
 #[cfg(feature = "embedded-graphics")]
 #[cfg_attr(docsrs, doc(cfg(feature = "embedded-graphics")))]
 pub use display::{DisplaySink, Dither};
+#[cfg(feature = "embedded-graphics")]
+pub use stream::{Fnv1a, Rgb565Stream, StreamError};
 
 use crate::error::{positive, Error};
 use crate::math::Rgb;

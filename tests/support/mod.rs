@@ -1,8 +1,10 @@
 //! What several integration tests share: reading the example scenes, a small
 //! deterministic generator, FNV-1a, and the generator of hostile scenes
-//! ([`hostile`]). Each test file takes it with `mod support;` and uses a part of it.
+//! ([`hostile`]), and the firmware's pipeline on the host ([`device`]). Each test
+//! file takes it with `mod support;` and uses a part of it.
 #![allow(dead_code)]
 
+pub mod device;
 pub mod hostile;
 
 use caustic::sampling::mix64;

@@ -81,7 +81,7 @@ def shorten(path):
     for pat, rep in (
         (r"^.*/library/", "std:"),
         (r"^.*/registry/src/[^/]+/", ""),
-        (r"^.*/examples/cortex-m4/", "firmware:"),
+        (r"^.*/examples/device/", "firmware:"),
     ):
         if re.match(pat, path):
             return re.sub(pat, rep, path)

@@ -1,4 +1,4 @@
-//! Puts `memory.x` where the linker finds it and links with cortex-m-rt's `link.x`.
+//! Puts `memory.x` where cortex-m-rt's `link.x` finds it.
 
 use std::env;
 use std::fs;
@@ -10,5 +10,4 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
-    println!("cargo:rustc-link-arg=-Tlink.x");
 }
