@@ -4,8 +4,10 @@
   path tree that follows both Fresnel branches for its first SPLIT specular interactions
   and then chooses one branch by Russian roulette on F (unbiased). At each diffuse vertex:
   point-light direct light (L D S* E); at diffuse vertices reached through >= 1 specular
-  interaction, the caustic irradiance from the photon map with a tiny disk kernel
-  (L S+ D S+ E, consistent).
+  interaction, the caustic irradiance from the photon map with a disk of 5% of the pixel's
+  footprint side at that vertex (finite differences along the same path), shrunk where it
+  holds > 1000 photons (L S+ D S+ E, consistent); also with twice that radius (gather2, the
+  bias estimate).
 * Caustics seen directly (L S+ D E) are not gathered: reference.Splat (light tracing).
 * Adaptive: a pilot of `spp` samples per pixel; pixels whose pilot standard error exceeds
   `tol` of max(pixel, 5% of the mean image luminance) are re-rendered with fresh samples
