@@ -164,11 +164,18 @@ impl<S: CausticStore> CausticStore for Timed<'_, S> {
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
         self.time(|| self.inner.classic(x, n, to_eye, m))
     }
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, r: f32) -> Rgb {
-        self.time(|| self.inner.irradiance_within(x, n, r))
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, r: f32, s: u32) -> Rgb {
+        self.time(|| self.inner.irradiance_within(x, n, r, s))
     }
-    fn classic_within(&self, x: Vec3, n: UnitVec3, e: UnitVec3, m: &Classic, r: f32) -> Rgb {
-        self.time(|| self.inner.classic_within(x, n, e, m, r))
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        e: UnitVec3,
+        m: &Classic,
+        rs: (f32, u32),
+    ) -> Rgb {
+        self.time(|| self.inner.classic_within(x, n, e, m, rs))
     }
 }
 

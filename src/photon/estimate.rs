@@ -92,16 +92,23 @@ impl<'a, const K: usize> KdStore<'a, K> {
         &self.tree
     }
 
-    /// Gathers the photons around `x` — the k nearest within the maximum radius, or with
-    /// a fixed radius every photon within it — and sums `weight(photon)` over those that
-    /// arrived on the front of the surface of normal `n`, with the cone filter if any.
-    /// Returns the sum (in W, including the filter's normalisation) and r².
+    /// Gathers the photons around `x` and sums `weight(photon)` over those that arrived
+    /// on the front of the surface of normal `n`, with the cone filter if any. Returns
+    /// the sum (in W, including the filter's normalisation) and r².
+    ///
+    /// With a footprint (radius² at most the maximum radius, and the number `s` of
+    /// sub-pixel rays that share the pixel's `k`), every photon within it when it holds
+    /// at least `⌈k/s⌉` of them — an estimate whose noise falls as photons are added,
+    /// like progressive photon mapping's — else the `k` nearest within the pixel's
+    /// footprint (`s` sub-footprints) and, without a footprint, within the maximum
+    /// radius (Jensen). With a fixed radius and no
+    /// footprint, every photon within the maximum radius.
     #[inline]
     fn gather(
         &self,
         x: Vec3,
         n: UnitVec3,
-        max_radius2: f32,
+        footprint2: Option<(f32, u32)>,
         mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
         let photons = self.tree.photons();
@@ -112,49 +119,59 @@ impl<'a, const K: usize> KdStore<'a, K> {
             ),
             None => (0.0, 1.0),
         };
-        let mut sum = Rgb::ZERO;
-        let mut add = |index: usize, dist2: f32, inv_kr: f32| {
+        // The weighted power of one photon, `None` when it arrived from behind.
+        let mut contribution = |index: usize, dist2: f32, inv_kr: f32| {
             let p = &photons[index];
             let dir = p.direction();
             if n.dot(dir.get()) >= 0.0 {
-                return; // arrived from behind the surface
+                return None;
             }
             let w = if self.cone.is_some() {
                 1.0 - crate::math::sqrt(dist2) * inv_kr
             } else {
                 1.0
             };
-            sum += weight(dir, p.power()) * w;
+            Some(weight(dir, p.power()) * w)
         };
-        let (r2, norm) = match self.k {
-            Some(k) => {
-                let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
-                let found = self.tree.k_nearest(x, max_radius2, k, &mut buf);
-                // Photon positions are known to about ε·|x|, and no estimate resolves
-                // detail below 10⁻⁴ of the gather radius: k photons all at the query
-                // point would otherwise divide by r² = 0. Floor r² there.
-                let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
-                let floor = crate::math::max(
-                    crate::math::max(ulp * ulp, 1e-8 * max_radius2),
-                    f32::MIN_POSITIVE,
-                );
-                let r2 = crate::math::max(found.radius2, floor);
-                let (inv_kr, norm) = filter(r2);
-                for nb in &buf {
-                    add(nb.index as usize, nb.dist2, inv_kr);
+        let disk = footprint2.or(self.k.is_none().then_some((self.max_radius2, 1)));
+        if let Some((r2, share)) = disk {
+            let (inv_kr, norm) = filter(r2);
+            let (mut sum, mut found) = (Rgb::ZERO, 0usize);
+            self.tree.search(x, r2, |index, dist2| {
+                if let Some(c) = contribution(index, dist2, inv_kr) {
+                    sum += c;
+                    found += 1;
                 }
-                (r2, norm)
+                r2
+            });
+            if self.k.is_none_or(|k| found * share.max(1) as usize >= k) {
+                return (sum * (self.unit * norm), r2);
             }
-            None => {
-                let r2 = max_radius2;
-                let (inv_kr, norm) = filter(r2);
-                self.tree.search(x, r2, |index, dist2| {
-                    add(index, dist2, inv_kr);
-                    r2
-                });
-                (r2, norm)
-            }
+        }
+        let k = self.k.unwrap_or(1);
+        // Behind a footprint, the nearest within the whole pixel's footprint only.
+        let reach2 = match footprint2 {
+            Some((r2, share)) => crate::math::min_num(self.max_radius2, r2 * share as f32),
+            None => self.max_radius2,
         };
+        let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
+        let found = self.tree.k_nearest(x, reach2, k, &mut buf);
+        // Photon positions are known to about ε·|x|, and no estimate resolves detail
+        // below 10⁻⁴ of the gather radius: k photons all at the query point would
+        // otherwise divide by r² = 0. Floor r² there.
+        let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
+        let floor = crate::math::max(
+            crate::math::max(ulp * ulp, 1e-8 * reach2),
+            f32::MIN_POSITIVE,
+        );
+        let r2 = crate::math::max(found.radius2, floor);
+        let (inv_kr, norm) = filter(r2);
+        let mut sum = Rgb::ZERO;
+        for nb in &buf {
+            if let Some(c) = contribution(nb.index as usize, nb.dist2, inv_kr) {
+                sum += c;
+            }
+        }
         (sum * (self.unit * norm), r2)
     }
 }
@@ -172,9 +189,9 @@ impl<const K: usize> KdStore<'_, K> {
         }
     }
 
-    /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons within `√r2_max`.
+    /// `E = Σ Φ_p / (π r²)` over the photons of [`gather`](Self::gather).
     #[inline]
-    fn irradiance2(&self, x: Vec3, n: UnitVec3, r2_max: f32) -> Rgb {
+    fn irradiance2(&self, x: Vec3, n: UnitVec3, r2_max: Option<(f32, u32)>) -> Rgb {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
@@ -182,9 +199,16 @@ impl<const K: usize> KdStore<'_, K> {
         sum * (1.0 / (PI * r2))
     }
 
-    /// Paper eq. 8 over the photons within `√r2_max`.
+    /// Paper eq. 8 over the photons of [`gather`](Self::gather).
     #[inline]
-    fn classic2(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic, r2_max: f32) -> Rgb {
+    fn classic2(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        to_eye: UnitVec3,
+        m: &Classic,
+        r2_max: Option<(f32, u32)>,
+    ) -> Rgb {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
@@ -213,18 +237,18 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// divided by the diffuse BRDF.
     #[inline]
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        self.irradiance2(x, n, self.max_radius2)
+        self.irradiance2(x, n, None)
     }
 
     /// Paper eq. 8: `c = (1/r²) Σ (max(n·l,0)·k_d·color + max(n·h,0)^a·k_s·color)·energy`.
     #[inline]
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        self.classic2(x, n, to_eye, m, self.max_radius2)
+        self.classic2(x, n, to_eye, m, None)
     }
 
     #[inline]
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
-        self.irradiance2(x, n, self.bound2(radius))
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32, samples: u32) -> Rgb {
+        self.irradiance2(x, n, Some((self.bound2(radius), samples)))
     }
 
     #[inline]
@@ -234,8 +258,8 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         n: UnitVec3,
         to_eye: UnitVec3,
         m: &Classic,
-        radius: f32,
+        (radius, samples): (f32, u32),
     ) -> Rgb {
-        self.classic2(x, n, to_eye, m, self.bound2(radius))
+        self.classic2(x, n, to_eye, m, Some((self.bound2(radius), samples)))
     }
 }

@@ -49,24 +49,27 @@ pub trait CausticStore {
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
 
-    /// As [`irradiance`](Self::irradiance), from photons within `radius` of `x` at most
-    /// (the footprint of the pixel that sees `x`): a store that gathers within a radius
-    /// bounds it by `radius` as well; others ignore it.
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32) -> Rgb {
-        let _ = radius;
+    /// As [`irradiance`](Self::irradiance), for one of `samples` sub-pixel rays whose
+    /// footprint has radius `radius` at `x`: a store that gathers a number of photons
+    /// may take every photon within the footprint once it holds a `samples`-th share of
+    /// that number (the pixel's estimate then uses about the whole number, and its
+    /// noise falls as photons are added). Others ignore both.
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32, samples: u32) -> Rgb {
+        let _ = (radius, samples);
         self.irradiance(x, n)
     }
 
-    /// As [`classic`](Self::classic), from photons within `radius` of `x` at most.
+    /// As [`classic`](Self::classic), for one of `samples` sub-pixel rays whose footprint
+    /// has radius `radius` at `x`.
     fn classic_within(
         &self,
         x: Vec3,
         n: UnitVec3,
         to_eye: UnitVec3,
         material: &Classic,
-        radius: f32,
+        (radius, samples): (f32, u32),
     ) -> Rgb {
-        let _ = radius;
+        let _ = (radius, samples);
         self.classic(x, n, to_eye, material)
     }
 }

@@ -135,6 +135,11 @@ struct Branch {
     depth: u32,
     /// Distance travelled from the eye to the ray's origin.
     travelled: f32,
+    /// Gather radius per unit of distance travelled: half the angle the sample stands
+    /// for (its pixel's, or its sub-pixel's in a grid).
+    spread: f32,
+    /// Rays of the pixel's grid that share its gather budget (`m²`; 1 for one ray).
+    share: u32,
 }
 
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
@@ -287,6 +292,12 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// Radiance arriving at the origin of `ray` along it, with the path's signature.
     pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
+        self.sample_within(ray, 1, count)
+    }
+
+    /// As [`sample`](Self::sample), for one ray of an `m × m` grid over the pixel: the
+    /// gathers behind glass stay within its sub-pixel's footprint.
+    pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
         let mut next = Some(Branch {
@@ -294,6 +305,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             weight: Rgb::ONE,
             depth: 0,
             travelled: 0.0,
+            spread: self.footprint / m.max(1) as f32,
+            share: m.max(1) * m.max(1),
         });
         let limit = count.eye + count.shadow + self.ray_budget as u64;
         while let Some(b) = next.take().or_else(|| stack.pop()) {
@@ -334,7 +347,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         match self.splats {
             None => Some(f32::INFINITY),
             Some(_) if b.depth == 0 => None,
-            Some(_) => Some(self.footprint * (b.travelled + hit.t)),
+            Some(_) => Some(b.spread * (b.travelled + hit.t)),
         }
     }
 
@@ -360,6 +373,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 weight: w,
                 depth: b.depth + 1,
                 travelled: b.travelled + hit.t,
+                spread: b.spread,
+                share: b.share,
             })
         };
         match material {
@@ -368,7 +383,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     return (Rgb::ZERO, None, None);
                 }
                 let caustic = match self.gather_radius(b, hit) {
-                    Some(r) => self.store.irradiance_within(hit.point, hit.normal, r),
+                    Some(r) => self
+                        .store
+                        .irradiance_within(hit.point, hit.normal, r, b.share),
                     None => Rgb::ZERO,
                 };
                 let mut e = caustic;
@@ -444,7 +461,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         let caustic = match self.gather_radius(b, hit) {
-            Some(r) => self.store.classic_within(hit.point, n, to_eye, c, r),
+            Some(r) => self
+                .store
+                .classic_within(hit.point, n, to_eye, c, (r, b.share)),
             None => Rgb::ZERO,
         };
         log.caustic += b.weight * caustic;

@@ -68,7 +68,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         for sy in 0..n {
             for sx in 0..n {
                 let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
-                let s = self.sample(camera.ray_at(x, y, fx, fy), count);
+                let s = self.sample_within(camera.ray_at(x, y, fx, fy), n, count);
                 let h = &mut half[((sx + sy) & 1) as usize];
                 h.0 += s.radiance;
                 h.1 += s.caustic;
