@@ -144,7 +144,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 }
                 r2
             });
-            if self.k.is_none_or(|k| found * share.max(1) as usize >= k) {
+            if footprint2.is_some() || self.k.is_none_or(|k| found * share.max(1) as usize >= k) {
                 return (sum * (self.unit * norm), r2);
             }
         }
