@@ -449,7 +449,7 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
                 loop {
                     let next = rows.lock().map(|mut r| r.next()).unwrap_or(None);
                     let Some((y, row)) = next else { break };
-                    mine += renderer.row_estimates(y as u32, row);
+                    mine += renderer.row(y as u32, row);
                     progress.tick();
                 }
                 if let Ok(mut t) = total.lock() {

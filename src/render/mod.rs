@@ -69,7 +69,7 @@ mod pixels;
 
 use crate::scene::Scene;
 pub use estimate::{ErrorTally, PixelEstimate};
-pub use pixels::{Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
+pub use pixels::{RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///

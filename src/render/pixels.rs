@@ -12,7 +12,7 @@
 use super::{PixelEstimate, RayCount, Renderer, RowsError, Sample};
 use crate::error::Error;
 use crate::math::Rgb;
-use crate::photon::{add_to_row, CausticStore};
+use crate::photon::{add_to_row, CausticStore, SplatTarget};
 
 /// How a pixel's area is sampled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,6 +52,26 @@ impl Sampling {
             Sampling::Grid(n) => n as u64 * n as u64 * b,
             Sampling::Adaptive(n) => (4 + n as u64 * n as u64 + REFINE_RAYS as u64) * b,
         }
+    }
+}
+
+/// What a row holds: radiance alone, or each pixel with its estimated error.
+pub trait RowPixel: SplatTarget {
+    /// The row's pixel from the renderer's estimate of it.
+    fn from_estimate(p: PixelEstimate) -> Self;
+}
+
+impl RowPixel for Rgb {
+    #[inline]
+    fn from_estimate(p: PixelEstimate) -> Self {
+        p.radiance
+    }
+}
+
+impl RowPixel for PixelEstimate {
+    #[inline]
+    fn from_estimate(p: PixelEstimate) -> Self {
+        p
     }
 }
 
@@ -181,15 +201,12 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         count
     }
 
-    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width), without the
-    /// splats (see [`with_splats`](Self::with_splats)).
-    pub fn row(&self, y: u32, row: &mut [Rgb]) -> RayCount {
-        self.row_with(y, row.len(), |x, p| row[x] = p.radiance)
-    }
-
-    /// As [`row`](Self::row), with each pixel's caustic part and error estimate.
-    pub fn row_estimates(&self, y: u32, row: &mut [PixelEstimate]) -> RayCount {
-        self.row_with(y, row.len(), |x, p| row[x] = p)
+    /// Renders row `y` (0 = top) into `row` (`row.len()` = image width): radiance
+    /// (`Rgb`) or each pixel with its caustic part and error estimate
+    /// ([`PixelEstimate`]), the same radiance bit for bit. Without the splats (see
+    /// [`with_splats`](Self::with_splats)).
+    pub fn row<T: RowPixel>(&self, y: u32, row: &mut [T]) -> RayCount {
+        self.row_with(y, row.len(), |x, p| row[x] = T::from_estimate(p))
     }
 
     /// The row buffer cut to the image width; an error when it is shorter.
@@ -212,34 +229,15 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// An error, before anything is rendered, when `row` is shorter than the image width
     /// ([`RowsError::Render`] with [`Error::Capacity`]); otherwise stops at the sink's
     /// first error and returns it ([`RowsError::Sink`]).
-    pub fn rows<E>(
+    pub fn rows<T: RowPixel, E>(
         &self,
-        row: &mut [Rgb],
-        mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), E>,
+        row: &mut [T],
+        mut sink: impl FnMut(u32, &[T]) -> Result<(), E>,
     ) -> Result<RayCount, RowsError<E>> {
         let row = self.fit(row)?;
         let mut count = RayCount::default();
         for y in 0..self.scene.camera().height() {
             count += self.row(y, row);
-            if let Some(splats) = self.splats {
-                add_to_row(splats, y, row);
-            }
-            sink(y, row).map_err(RowsError::Sink)?;
-        }
-        Ok(count)
-    }
-
-    /// As [`rows`](Self::rows), with each pixel's caustic part and error estimate (the
-    /// same radiance, bit for bit).
-    pub fn rows_estimates<E>(
-        &self,
-        row: &mut [PixelEstimate],
-        mut sink: impl FnMut(u32, &[PixelEstimate]) -> Result<(), E>,
-    ) -> Result<RayCount, RowsError<E>> {
-        let row = self.fit(row)?;
-        let mut count = RayCount::default();
-        for y in 0..self.scene.camera().height() {
-            count += self.row_estimates(y, row);
             if let Some(splats) = self.splats {
                 add_to_row(splats, y, row);
             }
