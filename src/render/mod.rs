@@ -339,9 +339,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         out
     }
 
-    /// The caustic store's part at a diffuse point reached by branch `b`: none where
-    /// the splats already hold it (seen directly), else the gather, bounded by the
-    /// footprint of the pixel's ray cone when splats are in use.
+    /// The radius of the caustic store's gather at a diffuse point reached by branch
+    /// `b`: none where the splats already hold it (seen directly); the footprint of the
+    /// ray's cone behind glass and mirrors when splats are in use; infinite (the
+    /// store's own gather, as in the paper) without splats.
     #[inline]
     fn gather_radius(&self, b: &Branch, hit: &Hit) -> Option<f32> {
         match self.splats {
@@ -383,9 +384,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     return (Rgb::ZERO, None, None);
                 }
                 let caustic = match self.gather_radius(b, hit) {
-                    Some(r) => self
+                    Some(r) if r.is_finite() => self
                         .store
                         .irradiance_within(hit.point, hit.normal, r, b.share),
+                    Some(_) => self.store.irradiance(hit.point, hit.normal),
                     None => Rgb::ZERO,
                 };
                 let mut e = caustic;
@@ -461,9 +463,11 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         let caustic = match self.gather_radius(b, hit) {
-            Some(r) => self
-                .store
-                .classic_within(hit.point, n, to_eye, c, (r, b.share)),
+            Some(r) if r.is_finite() => {
+                self.store
+                    .classic_within(hit.point, n, to_eye, c, (r, b.share))
+            }
+            Some(_) => self.store.classic(hit.point, n, to_eye, c),
             None => Rgb::ZERO,
         };
         log.caustic += b.weight * caustic;
