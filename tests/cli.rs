@@ -320,6 +320,9 @@ fn a_flag_replaces_only_its_key() {
             "--height",
             "30",
             "--quiet",
+            // The paper's gather at every diffuse hit, so that the gather choice shows
+            // (with splats the gathers behind glass take every photon in a footprint).
+            "--no-splat",
         ];
         args.extend_from_slice(extra);
         args.extend_from_slice(&["--pfm", s(out)]);
