@@ -197,7 +197,10 @@ pub struct Rendered {
 
 /// Frames of pixel estimates summed over passes. The mean of `P` passes has the
 /// caustic light tracer's squared error `Σ_p split_p²/P²` (the passes are independent)
-/// and the sampling error of one pass (every pass samples the same sub-pixel grid).
+/// and likewise `Σ_p sampling2_p/P²`: a supersampled pixel's checkerboard halves differ
+/// mostly by the gathers behind glass, which see new photons every pass. (The part of
+/// that difference that is the grid's own aliasing repeats from pass to pass and is
+/// underestimated this way as passes add up.)
 struct Passes {
     width: usize,
     radiance: vec::Vec<Rgb>,
@@ -239,7 +242,7 @@ impl Passes {
             radiance: self.radiance[i] * inv,
             caustic: self.caustic[i] * inv,
             split: Rgb::new(libm::sqrtf(s.r), libm::sqrtf(s.g), libm::sqrtf(s.b)) * inv,
-            sampling2: self.sampling2[i] * inv,
+            sampling2: self.sampling2[i] * (inv * inv),
         }
     }
 
