@@ -166,3 +166,38 @@ fn the_halves_estimate_the_light_tracers_error() {
         );
     }
 }
+
+/// `--target-error`: passes until the estimate reaches the target, then stop — the same
+/// passes and the same bits on any number of threads (the stopping test reads only
+/// deterministic numbers).
+#[test]
+fn a_target_error_stops_by_itself_with_the_same_bits_on_any_thread_count() {
+    use caustic::desktop::{parse_scene, render_with_error, RenderOptions};
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/glass_sphere.json"
+    ))
+    .unwrap();
+    let loaded = parse_scene(&text).unwrap();
+    let mut scene = loaded.scene;
+    scene.set_camera(scene.camera().with_size(48, 36).unwrap());
+    let settings = PhotonSettings::new(20_000, 64, 0.25, 8).unwrap();
+    let run = |threads: usize| {
+        let opts = RenderOptions {
+            threads,
+            target_error: Some(0.05),
+            ..RenderOptions::default()
+        };
+        render_with_error(&scene, &settings, &opts).unwrap()
+    };
+    let (a, b) = (run(1), run(3));
+    let e = a.stats.error;
+    assert_eq!(e.reached, Some(true));
+    assert!(e.rel_rmse.unwrap() <= 0.05 && a.stats.passes >= 1);
+    assert_eq!(a.stats.passes, b.stats.passes);
+    let bits = |img: &[Rgb]| -> Vec<[u32; 3]> {
+        img.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+    };
+    assert_eq!(bits(&a.image.pixels), bits(&b.image.pixels));
+    assert_eq!(bits(&a.error.pixels), bits(&b.error.pixels));
+}
