@@ -23,7 +23,7 @@ use srgb_table::SRGB8_THRESHOLDS;
 ///
 /// Counted from a start found by the value's bits: for positive floats the bit
 /// patterns are ordered like the values, so the exponent and the top four mantissa bits
-/// name one of [`BUCKETS`] sixteenths of an octave in `[2⁻¹³, 1)`, and `BUCKET_START`
+/// name one of `BUCKETS` sixteenths of an octave in `[2⁻¹³, 1)`, and `BUCKET_START`
 /// holds the count at the bucket's lower end. At most a few thresholds lie in a bucket,
 /// so a short forward scan ends the count — about 25 instructions a channel instead
 /// of a binary search's 85 (2.5 % of the device render), with the same result.
