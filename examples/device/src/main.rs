@@ -168,8 +168,7 @@ pub fn run() -> ! {
     caustic_mark_photons_begin();
     let forward = map.build(&scene, &settings, BUDGET.seed);
     caustic_mark_photons_end();
-    let forward =
-        forward.unwrap_or_else(|_| fail("forward pass (more photons or splats than the budget?)"));
+    let forward = forward.unwrap_or_else(|_| fail("forward pass: over budget"));
     hprintln!(
         "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
         forward.emitted,
