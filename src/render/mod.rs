@@ -127,6 +127,18 @@ impl core::ops::AddAssign for RayCount {
     }
 }
 
+/// Where the caustic light at a diffuse hit comes from.
+#[derive(Clone, Copy, Debug)]
+enum Gather {
+    /// The forward pass's splats hold it already (seen directly): no gather.
+    Splatted,
+    /// The store's own gather, as its settings say (the paper's way, without splats).
+    Store,
+    /// Every photon within this radius, the footprint of the ray's cone (behind glass
+    /// and mirrors, with splats).
+    Footprint(f32),
+}
+
 /// One pending branch of an eye path.
 #[derive(Clone, Copy, Debug)]
 struct Branch {
@@ -339,16 +351,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         out
     }
 
-    /// The radius of the caustic store's gather at a diffuse point reached by branch
-    /// `b`: none where the splats already hold it (seen directly); the footprint of the
-    /// ray's cone behind glass and mirrors when splats are in use; infinite (the
-    /// store's own gather, as in the paper) without splats.
+    /// How the caustic store gathers at a diffuse point reached by branch `b`.
     #[inline]
-    fn gather_radius(&self, b: &Branch, hit: &Hit) -> Option<f32> {
+    fn gather(&self, b: &Branch, hit: &Hit) -> Gather {
         match self.splats {
-            None => Some(f32::INFINITY),
-            Some(_) if b.depth == 0 => None,
-            Some(_) => Some(b.spread * (b.travelled + hit.t)),
+            None => Gather::Store,
+            Some(_) if b.depth == 0 => Gather::Splatted,
+            Some(_) => Gather::Footprint(b.spread * (b.travelled + hit.t)),
         }
     }
 
@@ -383,12 +392,12 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !front {
                     return (Rgb::ZERO, None, None);
                 }
-                let caustic = match self.gather_radius(b, hit) {
-                    Some(r) if r.is_finite() => self
+                let caustic = match self.gather(b, hit) {
+                    Gather::Footprint(r) => self
                         .store
                         .irradiance_within(hit.point, hit.normal, r, b.share),
-                    Some(_) => self.store.irradiance(hit.point, hit.normal),
-                    None => Rgb::ZERO,
+                    Gather::Store => self.store.irradiance(hit.point, hit.normal),
+                    Gather::Splatted => Rgb::ZERO,
                 };
                 let mut e = caustic;
                 for light in self.scene.lights() {
@@ -462,13 +471,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        let caustic = match self.gather_radius(b, hit) {
-            Some(r) if r.is_finite() => {
+        let caustic = match self.gather(b, hit) {
+            Gather::Footprint(r) => {
                 self.store
                     .classic_within(hit.point, n, to_eye, c, (r, b.share))
             }
-            Some(_) => self.store.classic(hit.point, n, to_eye, c),
-            None => Rgb::ZERO,
+            Gather::Store => self.store.classic(hit.point, n, to_eye, c),
+            Gather::Splatted => Rgb::ZERO,
         };
         log.caustic += b.weight * caustic;
         ambient + lit + caustic
