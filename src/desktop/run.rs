@@ -131,6 +131,16 @@ pub struct ErrorEstimate {
 }
 
 impl ErrorEstimate {
+    /// This estimate, with the target fields of `run` (what the passes were asked for).
+    fn with_target_of(self, run: &Self) -> Self {
+        Self {
+            target: run.target,
+            reached: run.reached,
+            time_limited: run.time_limited,
+            ..self
+        }
+    }
+
     fn from_tally(t: &ErrorTally) -> Self {
         Self {
             rel_rmse: t.rel_rmse(),
@@ -369,17 +379,7 @@ pub fn render_with_error(
         }
     }
     progress.finish();
-    let (target, reached, limited) = (
-        stats.error.target,
-        stats.error.reached,
-        stats.error.time_limited,
-    );
-    stats.error = ErrorEstimate {
-        target,
-        reached,
-        time_limited: limited,
-        ..ErrorEstimate::from_tally(&sum.tally())
-    };
+    stats.error = ErrorEstimate::from_tally(&sum.tally()).with_target_of(&stats.error);
     let (image, error) = sum.images(w, h);
     Ok(Rendered {
         image,
