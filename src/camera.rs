@@ -162,6 +162,24 @@ impl Camera {
         2.0 * self.half_h / self.height as f32
     }
 
+    /// How the direction `dir` of a camera ray changes per pixel step along the image's
+    /// x and y (ray differentials, Igehy 1999; pbrt-v4 §5.2.4): with
+    /// `w = forward + u·right + v·up` and `dir = w/|w|`,
+    /// `∂dir = (∂w − dir·(dir·∂w))/|w|`, `∂w/∂x = right·2·half_w/W`,
+    /// `∂w/∂y = −up·2·half_h/H`, and `1/|w| = dir·forward`. The origin does not move
+    /// (a pinhole).
+    #[inline]
+    pub fn direction_derivatives(&self, dir: UnitVec3) -> [Vec3; 2] {
+        let d = dir.get();
+        let inv_len = d.dot(self.forward);
+        let dwdx = self.right * (2.0 * self.half_w / self.width as f32);
+        let dwdy = self.up * (-2.0 * self.half_h / self.height as f32);
+        [
+            (dwdx - d * d.dot(dwdx)) * inv_len,
+            (dwdy - d * d.dot(dwdy)) * inv_len,
+        ]
+    }
+
     /// Projects the surface point `p` of normal `n` through the pinhole: the inverse of
     /// [`ray_at`](Self::ray_at). `None` behind the eye or outside the image.
     ///

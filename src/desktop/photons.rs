@@ -11,7 +11,8 @@ use super::progress::Progress;
 use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
 use crate::photon::{
-    self, balance, photons_needed, Emitter, KdTree, Landed, Photon, PhotonSettings, Splat,
+    self, balance, photons_needed, Emitter, KdStore, KdTree, Landed, Photon, PhotonSettings, Splat,
+    THINNING,
 };
 use crate::scene::Scene;
 use crate::Error;
@@ -24,6 +25,8 @@ pub struct PhotonBuffer {
     len: usize,
     unit: f32,
     splats: vec::Vec<Splat>,
+    /// The coarse levels of the store (see [`KdStore::with_coarse_levels`]), balanced.
+    coarse: [vec::Vec<Photon>; 2],
 }
 
 /// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
@@ -108,6 +111,7 @@ impl PhotonBuffer {
             len: 0,
             unit: 0.0,
             splats: vec::Vec::new(),
+            coarse: [vec::Vec::new(), vec::Vec::new()],
         })
     }
 
@@ -189,6 +193,17 @@ impl PhotonBuffer {
         }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
+        // Every THINNING-th photon in emission order: a selection that does not depend
+        // on where the photons landed, so each stands for THINNING of them.
+        let thin = |from: &[Photon]| -> vec::Vec<Photon> {
+            from.iter().step_by(THINNING).copied().collect()
+        };
+        let level1 = thin(&self.photons[..stored]);
+        let level2 = thin(&level1);
+        self.coarse = [level1, level2];
+        for level in &mut self.coarse {
+            balance(level);
+        }
         balance_parallel(&mut self.photons[..stored], threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
@@ -201,6 +216,17 @@ impl PhotonBuffer {
     /// The balanced tree of the last pass.
     pub fn tree(&self) -> KdTree<'_> {
         KdTree::from_balanced(&self.photons[..self.len])
+    }
+
+    /// The caustic store over the last pass's tree and its coarse levels, gathering up
+    /// to `K` photons as `settings` say.
+    pub fn store<const K: usize>(
+        &self,
+        settings: &PhotonSettings,
+    ) -> Result<KdStore<'_, K>, Error> {
+        let [level1, level2] = &self.coarse;
+        Ok(photon::store_over::<K>(self.tree(), self.unit, settings)?
+            .with_coarse_levels(KdTree::from_balanced(level1), KdTree::from_balanced(level2)))
     }
 
     /// Power of one stored unit, W.

@@ -19,7 +19,7 @@ use super::progress::Progress;
 use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::photon::{self, add_to_frame, CausticStore, Photon, PhotonSettings, Splat};
+use crate::photon::{self, add_to_frame, CausticStore, Footprint, Photon, PhotonSettings, Splat};
 use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
 use crate::Error;
 
@@ -174,18 +174,11 @@ impl<S: CausticStore> CausticStore for Timed<'_, S> {
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
         self.time(|| self.inner.classic(x, n, to_eye, m))
     }
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, r: f32, s: u32) -> Rgb {
-        self.time(|| self.inner.irradiance_within(x, n, r, s))
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, f: &Footprint) -> Rgb {
+        self.time(|| self.inner.irradiance_within(x, n, f))
     }
-    fn classic_within(
-        &self,
-        x: Vec3,
-        n: UnitVec3,
-        e: UnitVec3,
-        m: &Classic,
-        rs: (f32, u32),
-    ) -> Rgb {
-        self.time(|| self.inner.classic_within(x, n, e, m, rs))
+    fn classic_within(&self, x: Vec3, n: UnitVec3, e: UnitVec3, m: &Classic, f: &Footprint) -> Rgb {
+        self.time(|| self.inner.classic_within(x, n, e, m, f))
     }
 }
 
@@ -329,14 +322,19 @@ pub fn render_with_error(
     );
     // Without splats, progressive passes gather with a fixed radius (a k-nearest
     // radius would not shrink with the passes, and the average would keep its bias);
-    // with them the gather is bounded by the shrinking pixel footprint.
+    // with them the gather is over each sample's own patch of surface, which every
+    // pass estimates without a radius to shrink.
     let fixed = settings.fixed_radius() || (passes > 1 && !settings.camera_splats());
     let settings = &settings.with_fixed_radius(fixed);
     let mut photons = PhotonBuffer::for_budget(scene, settings)?;
     let mut sum = Passes::new(w as usize, w as usize * h as usize);
     for pass in 0..passes {
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
-        let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
+        let shrink = if settings.camera_splats() {
+            1.0
+        } else {
+            libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0))
+        };
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
         photons.fill_with_progress(
             scene,
@@ -347,19 +345,10 @@ pub fn render_with_error(
             &mut stats,
             &progress,
         )?;
-        let store =
-            photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), &pass_settings)?;
+        let store = photons.store::<MAX_GATHER>(&pass_settings)?;
         let splats = settings.camera_splats().then(|| photons.splats());
         progress.phase(pass, "rows", h as usize);
-        let frame = backward_pass(
-            scene,
-            &store,
-            settings,
-            (splats, shrink),
-            opts,
-            &progress,
-            &mut stats,
-        )?;
+        let frame = backward_pass(scene, &store, settings, splats, opts, &progress, &mut stats)?;
         sum.add(&frame);
         stats.passes = pass + 1;
         if let Some(target) = opts.target_error {
@@ -389,14 +378,14 @@ pub fn render_with_error(
 }
 
 /// The backward pass against one caustic store on `opts.threads` threads: a frame of
-/// pixel estimates, the splats (the caustics seen directly, with the pass's radius
-/// shrink factor) added in emission order after its rows. Adds its time, its gather
+/// pixel estimates, the splats (the caustics seen directly) added in emission order
+/// after its rows. Adds its time, its gather
 /// time and its rays to `stats`.
 fn backward_pass<S: CausticStore + Sync>(
     scene: &DesktopScene,
     store: &S,
     settings: &PhotonSettings,
-    (splats, shrink): (Option<&[Splat]>, f32),
+    splats: Option<&[Splat]>,
     opts: &RenderOptions,
     progress: &Progress,
     stats: &mut RenderStats,
@@ -406,9 +395,7 @@ fn backward_pass<S: CausticStore + Sync>(
         nanos: AtomicU64::new(0),
     };
     let mut renderer: Renderer<'_, _, { super::MAX_OBJECTS }, { super::MAX_LIGHTS }, MAX_DEPTH> =
-        Renderer::new(scene, &timed, settings.max_depth())?
-            .with_sampling(opts.sampling)?
-            .with_footprint_scale(shrink);
+        Renderer::new(scene, &timed, settings.max_depth())?.with_sampling(opts.sampling)?;
     if let Some(budget) = opts.max_rays_per_sample {
         renderer = renderer.with_ray_budget(budget)?;
     }
@@ -513,15 +500,7 @@ pub fn render_illumination(
     progress.tick();
     progress.phase(0, "rows", h as usize);
     let splats = settings.camera_splats().then_some(&splats[..]);
-    let frame = backward_pass(
-        scene,
-        &maps,
-        settings,
-        (splats, 1.0),
-        opts,
-        &progress,
-        &mut stats,
-    )?;
+    let frame = backward_pass(scene, &maps, settings, splats, opts, &progress, &mut stats)?;
     progress.finish();
     let mut sum = Passes::new(w as usize, frame.len());
     sum.add(&frame);

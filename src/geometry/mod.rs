@@ -166,6 +166,28 @@ impl Shape {
         }
     }
 
+    /// How the outward normal at the surface point of normal `n` turns as the point
+    /// moves by `dp` along the surface (`∂n = (∂n/∂p)·dp`): for ray differentials
+    /// through curved glass and mirrors (Igehy 1999). A sphere's normal `(p − c)/r`
+    /// turns by `dp/r`; a cylinder's side by the part of `dp` across the axis over
+    /// `r`; flat faces (planes, box faces, caps) not at all.
+    #[inline]
+    pub fn normal_derivative(&self, n: UnitVec3, dp: Vec3) -> Vec3 {
+        match self {
+            Shape::Sphere(s) => dp * (1.0 / s.radius()),
+            Shape::Cylinder(c) => {
+                let a = c.axis().get();
+                // The caps' normals are ±axis; the side's are perpendicular to it.
+                if n.dot(a).abs() > 0.5 {
+                    Vec3::ZERO
+                } else {
+                    (dp - a * dp.dot(a)) * (1.0 / c.radius())
+                }
+            }
+            Shape::Box(_) | Shape::Plane(_) => Vec3::ZERO,
+        }
+    }
+
     /// `false` for the unbounded plane.
     #[inline]
     pub fn is_bounded(&self) -> bool {

@@ -27,6 +27,134 @@ impl ConeFilter {
     }
 }
 
+/// The patch of surface one eye sample stands for, seen through glass or in a mirror:
+/// the parallelogram `x + α·a + β·b`, `|α|, |β| ≤ 1`, whose half-axes `a`, `b` are the
+/// sample's ray differentials (Igehy 1999) at the hit times half its extent on the image.
+/// A pixel's value is the average radiance over its area; under the differentials'
+/// linearisation the pixel's preimage on the surface is this parallelogram, so the
+/// photons inside it divided by its area estimate the average irradiance over the
+/// pixel — the box filter of the contract, with no kernel of its own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    /// First half-axis (the image's x direction), scene units.
+    pub a: Vec3,
+    /// Second half-axis (the image's y direction), scene units.
+    pub b: Vec3,
+}
+
+/// Most disks one footprint's search is cut into (see `Region::segments`).
+const MAX_SEGMENTS: u32 = 16;
+
+/// How a footprint is searched: a parallelogram, or (when it is degenerate) a disk.
+#[derive(Clone, Copy, Debug)]
+struct Region {
+    a: Vec3,
+    b: Vec3,
+    /// `(a·a, a·b, b·b)` over the Gram determinant `|a × b|²`: solves `q = α·a + β·b`.
+    aa: f32,
+    ab: f32,
+    bb: f32,
+    /// Radius² of the search: the half-diagonal's square.
+    reach2: f32,
+    /// The region's area (`4·|a × b|`, or the disk's).
+    area: f32,
+    /// `false`: every photon within `reach2` counts (a degenerate parallelogram).
+    parallelogram: bool,
+}
+
+impl Region {
+    /// The footprint, scaled down to fit within `max_radius2` (a bound on the work, and
+    /// the store's own radius: the estimate is then of a smaller patch's average); a
+    /// parallelogram too thin to solve (where the differentials fold: a focus seen
+    /// edge-on) becomes the disk of its half-diagonal.
+    fn new(f: &Footprint, max_radius2: f32) -> Option<Self> {
+        let (mut a, mut b) = (f.a, f.b);
+        let reach2 = crate::math::max((a + b).length_squared(), (a - b).length_squared());
+        if !(reach2 > 0.0) || !reach2.is_finite() {
+            return None;
+        }
+        let reach2 = if reach2 > max_radius2 {
+            let s = crate::math::sqrt(max_radius2 / reach2);
+            (a, b) = (a * s, b * s);
+            max_radius2
+        } else {
+            reach2
+        };
+        let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
+        let det = aa * bb - ab * ab;
+        if det > 1e-6 * aa * bb && det >= f32::MIN_POSITIVE {
+            let inv = 1.0 / det;
+            Some(Self {
+                a,
+                b,
+                aa: aa * inv,
+                ab: ab * inv,
+                bb: bb * inv,
+                reach2,
+                area: 4.0 * crate::math::sqrt(det),
+                parallelogram: true,
+            })
+        } else {
+            Some(Self {
+                a,
+                b,
+                aa: 0.0,
+                ab: 0.0,
+                bb: 0.0,
+                reach2,
+                area: PI * reach2,
+                parallelogram: false,
+            })
+        }
+    }
+
+    /// The region scaled about its centre to `s2` times its area.
+    fn scaled(&self, s2: f32) -> Self {
+        let s = crate::math::sqrt(s2);
+        let inv = 1.0 / s2;
+        Self {
+            a: self.a * s,
+            b: self.b * s,
+            aa: self.aa * inv,
+            ab: self.ab * inv,
+            bb: self.bb * inv,
+            reach2: self.reach2 * s2,
+            area: self.area * s2,
+            parallelogram: self.parallelogram,
+        }
+    }
+
+    /// The coordinates `(α, β)` of the offset `q` from the centre, `q = α·a + β·b`
+    /// (its component along the surface normal ignored: `a` and `b` lie in the tangent
+    /// plane), when it lies inside; a disk holds every offset within its reach, at
+    /// `(0, 0)`.
+    #[inline]
+    fn coords(&self, q: Vec3) -> Option<(f32, f32)> {
+        if !self.parallelogram {
+            return Some((0.0, 0.0));
+        }
+        let (qa, qb) = (q.dot(self.a), q.dot(self.b));
+        let alpha = qa * self.bb - qb * self.ab;
+        let beta = qb * self.aa - qa * self.ab;
+        (alpha.abs() <= 1.0 && beta.abs() <= 1.0).then_some((alpha, beta))
+    }
+
+    /// How many disks cover the parallelogram along `a` (its longer half-axis, or
+    /// `b`'s when `along_b`): a sliver — a focus seen through a tube — searched as one
+    /// disk would visit the photons of a square `|a|/|b|` times its area.
+    #[inline]
+    fn segments(&self) -> (u32, bool) {
+        if !self.parallelogram {
+            return (1, false);
+        }
+        let (la, lb) = (self.a.length_squared(), self.b.length_squared());
+        let along_b = lb > la;
+        let ratio = crate::math::sqrt(if along_b { lb / la } else { la / lb });
+        // `as` saturates, and NaN becomes 0.
+        ((ratio as u32).clamp(1, MAX_SEGMENTS), along_b)
+    }
+}
+
 /// A kd-tree photon map used as a caustic store, gathering up to `K` photons
 /// (the compiled capacity of the gather; `k ≤ K` photons are used), or every photon
 /// within a fixed radius.
@@ -41,7 +169,19 @@ pub struct KdStore<'a, const K: usize> {
     cone: Option<ConeFilter>,
     /// The photons' bounding box (`lo`, `hi`); empty (`lo > hi`) without photons.
     bounds: (Vec3, Vec3),
+    /// Thinned copies of the map for footprints that hold many photons: every
+    /// [`THINNING`]-th photon of the level before, each standing for that many.
+    coarse: [Option<KdTree<'a>>; 2],
 }
+
+/// The thinning of each coarse level of a [`KdStore`].
+pub const THINNING: usize = 16;
+
+/// Most photons one footprint gather visits on one level: a footprint that would hold
+/// more is gathered on the finest coarse level where it holds fewer (unbiased: each
+/// photon there stands for [`THINNING`]ˡ of the map's), and beyond the coarsest it is
+/// scaled down about its centre.
+pub const FOOTPRINT_VISITS: usize = 1024;
 
 impl<'a, const K: usize> KdStore<'a, K> {
     /// A store over a balanced tree whose photon powers are in units of `unit` W,
@@ -62,7 +202,16 @@ impl<'a, const K: usize> KdStore<'a, K> {
             max_radius2: max_radius * max_radius,
             cone,
             bounds: bounds(tree.photons()),
+            coarse: [None; 2],
         }
+    }
+
+    /// The same store with coarse levels for large footprints: `level1` holds every
+    /// [`THINNING`]-th photon of the map (any fixed selection independent of where the
+    /// photons lie), `level2` every `THINNING`-th of `level1`, each balanced.
+    pub fn with_coarse_levels(mut self, level1: KdTree<'a>, level2: KdTree<'a>) -> Self {
+        self.coarse = [Some(level1), Some(level2)];
+        self
     }
 
     /// `true` when no photon can lie within the gather radius of `x`: `x` is farther
@@ -94,21 +243,14 @@ impl<'a, const K: usize> KdStore<'a, K> {
 
     /// Gathers the photons around `x` and sums `weight(photon)` over those that arrived
     /// on the front of the surface of normal `n`, with the cone filter if any. Returns
-    /// the sum (in W, including the filter's normalisation) and r².
-    ///
-    /// With a footprint (radius² at most the maximum radius, and the number `s` of
-    /// sub-pixel rays that share the pixel's `k`), every photon within it when it holds
-    /// at least `⌈k/s⌉` of them — an estimate whose noise falls as photons are added,
-    /// like progressive photon mapping's — else the `k` nearest within the pixel's
-    /// footprint (`s` sub-footprints) and, without a footprint, within the maximum
-    /// radius (Jensen). With a fixed radius and no
-    /// footprint, every photon within the maximum radius.
+    /// the sum (in W, including the filter's normalisation) and r²: the `k` nearest
+    /// within the maximum radius (Jensen), or with a fixed radius every photon within
+    /// the maximum radius.
     #[inline]
     fn gather(
         &self,
         x: Vec3,
         n: UnitVec3,
-        footprint2: Option<(f32, u32)>,
         mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
         let photons = self.tree.photons();
@@ -133,35 +275,26 @@ impl<'a, const K: usize> KdStore<'a, K> {
             };
             Some(weight(dir, p.power()) * w)
         };
-        let disk = footprint2.or(self.k.is_none().then_some((self.max_radius2, 1)));
-        if let Some((r2, share)) = disk {
+        let Some(k) = self.k else {
+            let r2 = self.max_radius2;
             let (inv_kr, norm) = filter(r2);
-            let (mut sum, mut found) = (Rgb::ZERO, 0usize);
+            let mut sum = Rgb::ZERO;
             self.tree.search(x, r2, |index, dist2| {
                 if let Some(c) = contribution(index, dist2, inv_kr) {
                     sum += c;
-                    found += 1;
                 }
                 r2
             });
-            if footprint2.is_some() || self.k.is_none_or(|k| found * share.max(1) as usize >= k) {
-                return (sum * (self.unit * norm), r2);
-            }
-        }
-        let k = self.k.unwrap_or(1);
-        // Behind a footprint, the nearest within the whole pixel's footprint only.
-        let reach2 = match footprint2 {
-            Some((r2, share)) => crate::math::min_num(self.max_radius2, r2 * share as f32),
-            None => self.max_radius2,
+            return (sum * (self.unit * norm), r2);
         };
         let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
-        let found = self.tree.k_nearest(x, reach2, k, &mut buf);
+        let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
         // Photon positions are known to about ε·|x|, and no estimate resolves detail
         // below 10⁻⁴ of the gather radius: k photons all at the query point would
         // otherwise divide by r² = 0. Floor r² there.
         let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
         let floor = crate::math::max(
-            crate::math::max(ulp * ulp, 1e-8 * reach2),
+            crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
             f32::MIN_POSITIVE,
         );
         let r2 = crate::math::max(found.radius2, floor);
@@ -174,45 +307,127 @@ impl<'a, const K: usize> KdStore<'a, K> {
         }
         (sum * (self.unit * norm), r2)
     }
-}
 
-impl<const K: usize> KdStore<'_, K> {
-    /// The gather radius² bound: the store's maximum radius, or `radius` if smaller
-    /// (but never a radius whose square is not a normal float).
+    /// Sums `weight(photon)` over the photons inside the footprint that arrived on the
+    /// front of the surface of normal `n` (no cone filter: the footprint is the
+    /// kernel). Returns the sum in W and the area it covers, or `None` for an empty or
+    /// non-finite footprint. Unbiased for the patch's average irradiance, whatever its
+    /// size or shape; the work is bounded by [`FOOTPRINT_VISITS`] photons per search.
     #[inline]
-    fn bound2(&self, radius: f32) -> f32 {
-        let r2 = radius * radius;
-        if r2 >= f32::MIN_POSITIVE && r2 < self.max_radius2 {
-            r2
-        } else {
-            self.max_radius2
+    fn gather_footprint(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        footprint: &Footprint,
+        mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
+    ) -> Option<(Rgb, f32)> {
+        let region = Region::new(footprint, self.max_radius2)?;
+        if self.out_of_reach(x) {
+            return Some((Rgb::ZERO, region.area));
+        }
+        // The finest level where the footprint visits at most FOOTPRINT_VISITS
+        // photons: a search that would visit more stops there and is tried again — a
+        // sliver cut into disks, then on the next coarser level, at last scaled down.
+        let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
+        let (mut region, mut level, mut cut) = (region, 0, false);
+        loop {
+            let (sum, visits) = self.sum_in(levels[level], x, n, &region, cut, &mut weight);
+            if visits.is_some() {
+                let scale = (THINNING as f32).powi(level as i32);
+                return Some((sum * (self.unit * scale), region.area));
+            }
+            if !cut && region.segments().0 > 1 {
+                cut = true;
+            } else if levels.get(level + 1).is_some_and(Option::is_some) {
+                level += 1;
+            } else {
+                region = region.scaled(0.25);
+            }
         }
     }
 
+    /// The weighted sum of the front-side photons of `tree` inside `region` and the
+    /// photons visited; `None` visits when they would exceed [`FOOTPRINT_VISITS`].
+    #[inline]
+    fn sum_in(
+        &self,
+        tree: Option<KdTree<'_>>,
+        x: Vec3,
+        n: UnitVec3,
+        region: &Region,
+        cut: bool,
+        weight: &mut impl FnMut(UnitVec3, Rgb) -> Rgb,
+    ) -> (Rgb, Option<usize>) {
+        let Some(tree) = tree else {
+            return (Rgb::ZERO, Some(0));
+        };
+        let photons = tree.photons();
+        let (mut sum, mut visited) = (Rgb::ZERO, 0usize);
+        let (segments, along_b) = if cut { region.segments() } else { (1, false) };
+        let (long, short) = if along_b {
+            (region.b, region.a)
+        } else {
+            (region.a, region.b)
+        };
+        let step = 2.0 / segments as f32;
+        let piece = long * (1.0 / segments as f32);
+        let reach2 = crate::math::max(
+            (piece + short).length_squared(),
+            (piece - short).length_squared(),
+        );
+        for j in 0..segments {
+            // Segment j holds the long coordinate in [−1 + j·step, −1 + (j+1)·step)
+            // (the last one closed): every photon is counted once.
+            let lo = -1.0 + j as f32 * step;
+            let hi = if j + 1 == segments {
+                f32::INFINITY
+            } else {
+                lo + step
+            };
+            let centre = x + long * (lo + 0.5 * step);
+            let reach2 = if segments == 1 { region.reach2 } else { reach2 };
+            tree.search(centre, reach2, |index, _| {
+                visited += 1;
+                if visited > FOOTPRINT_VISITS {
+                    return 0.0; // ends the search
+                }
+                let p = &photons[index];
+                let dir = p.direction();
+                let inside = region.coords(p.position() - x).filter(|&(alpha, beta)| {
+                    let t = if along_b { beta } else { alpha };
+                    segments == 1 || (t >= lo && t < hi)
+                });
+                if inside.is_some() && n.dot(dir.get()) < 0.0 {
+                    sum += weight(dir, p.power());
+                }
+                reach2
+            });
+            if visited > FOOTPRINT_VISITS {
+                return (sum, None);
+            }
+        }
+        (sum, Some(visited))
+    }
+}
+
+impl<const K: usize> KdStore<'_, K> {
     /// `E = Σ Φ_p / (π r²)` over the photons of [`gather`](Self::gather).
     #[inline]
-    fn irradiance2(&self, x: Vec3, n: UnitVec3, r2_max: Option<(f32, u32)>) -> Rgb {
+    fn irradiance_near(&self, x: Vec3, n: UnitVec3) -> Rgb {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
-        let (sum, r2) = self.gather(x, n, r2_max, |_, power| power);
+        let (sum, r2) = self.gather(x, n, |_, power| power);
         sum * (1.0 / (PI * r2))
     }
 
     /// Paper eq. 8 over the photons of [`gather`](Self::gather).
     #[inline]
-    fn classic2(
-        &self,
-        x: Vec3,
-        n: UnitVec3,
-        to_eye: UnitVec3,
-        m: &Classic,
-        r2_max: Option<(f32, u32)>,
-    ) -> Rgb {
+    fn classic_near(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
-        let (sum, r2) = self.gather(x, n, r2_max, |dir, power| m.kernel(n, -dir, to_eye) * power);
+        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
         sum * (1.0 / r2)
     }
 }
@@ -237,20 +452,27 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// divided by the diffuse BRDF.
     #[inline]
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        self.irradiance2(x, n, None)
+        self.irradiance_near(x, n)
     }
 
     /// Paper eq. 8: `c = (1/r²) Σ (max(n·l,0)·k_d·color + max(n·h,0)^a·k_s·color)·energy`.
     #[inline]
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        self.classic2(x, n, to_eye, m, None)
+        self.classic_near(x, n, to_eye, m)
     }
 
+    /// `E = Σ Φ_p / A` over the front-side photons inside the footprint of area `A`
+    /// (the store's own estimate for an empty footprint).
     #[inline]
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32, samples: u32) -> Rgb {
-        self.irradiance2(x, n, Some((self.bound2(radius), samples)))
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Rgb {
+        match self.gather_footprint(x, n, footprint, |_, power| power) {
+            Some((sum, area)) => sum * (1.0 / area),
+            None => self.irradiance_near(x, n),
+        }
     }
 
+    /// Paper eq. 8 over the photons inside the footprint, its `1/r²` the disk's of the
+    /// same area (`π/A`).
     #[inline]
     fn classic_within(
         &self,
@@ -258,8 +480,12 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         n: UnitVec3,
         to_eye: UnitVec3,
         m: &Classic,
-        (radius, samples): (f32, u32),
+        footprint: &Footprint,
     ) -> Rgb {
-        self.classic2(x, n, to_eye, m, Some((self.bound2(radius), samples)))
+        let kernel = |dir: UnitVec3, power| m.kernel(n, -dir, to_eye) * power;
+        match self.gather_footprint(x, n, footprint, kernel) {
+            Some((sum, area)) => sum * (PI / area),
+            None => self.classic_near(x, n, to_eye, m),
+        }
     }
 }

@@ -17,7 +17,7 @@ mod packed;
 mod splat;
 mod trace;
 
-pub use estimate::{ConeFilter, KdStore};
+pub use estimate::{ConeFilter, Footprint, KdStore, FOOTPRINT_VISITS, THINNING};
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
@@ -49,27 +49,24 @@ pub trait CausticStore {
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
 
-    /// As [`irradiance`](Self::irradiance), for one of `samples` sub-pixel rays whose
-    /// footprint has radius `radius` at `x`: a store that gathers a number of photons
-    /// may take every photon within the footprint once it holds a `samples`-th share of
-    /// that number (the pixel's estimate then uses about the whole number, and its
-    /// noise falls as photons are added). Others ignore both.
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, radius: f32, samples: u32) -> Rgb {
-        let _ = (radius, samples);
+    /// As [`irradiance`](Self::irradiance), averaged over the patch one eye sample
+    /// stands for (a diffuse point seen through glass or in a mirror): the box filter of
+    /// a pixel. A store that cannot restrict its estimate to the patch ignores it.
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Rgb {
+        let _ = footprint;
         self.irradiance(x, n)
     }
 
-    /// As [`classic`](Self::classic), for one of `samples` sub-pixel rays whose footprint
-    /// has radius `radius` at `x`.
+    /// As [`classic`](Self::classic), over the patch one eye sample stands for.
     fn classic_within(
         &self,
         x: Vec3,
         n: UnitVec3,
         to_eye: UnitVec3,
         material: &Classic,
-        (radius, samples): (f32, u32),
+        footprint: &Footprint,
     ) -> Rgb {
-        let _ = (radius, samples);
+        let _ = footprint;
         self.classic(x, n, to_eye, material)
     }
 }

@@ -10,10 +10,13 @@
 //! - the sub-pixel sampling's: in a supersampled pixel, the two checkerboard halves of
 //!   its grid ([`Sampling`](super::Sampling)) give `((m_a − m_b)/2)²`.
 //!
-//! Not estimated, and stated where it is reported: the bias of the gather behind glass
-//! and mirrors (within the pixel's footprint, it shrinks with the footprint), and the
-//! error of a pixel whose four corners agreed (smooth there by the test that let them
-//! agree).
+//! Not estimated, and stated where it is reported: the noise of the gather behind
+//! glass and mirrors in a pixel that was not supersampled (a supersampled pixel's
+//! checkerboard halves gather over disjoint halves of its preimage, so their
+//! difference holds it), the gather's bias where the ray differentials' linear
+//! preimage of the pixel departs from the true one (at a silhouette or a fold of the
+//! focus; a supersampled pixel's sub-pixels shrink it), and the error of a pixel whose
+//! four corners agreed (smooth there by the test that let them agree).
 
 use crate::math::Rgb;
 use crate::photon::{Splat, SplatTarget};

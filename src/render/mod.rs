@@ -16,10 +16,12 @@
 //! the surface directly, the forward pass has already added it to the pixel by light
 //! tracing ([`photon::Splat`](crate::photon::Splat), given to
 //! [`Renderer::with_splats`]): unbiased and exactly a pixel-area average. Where the eye
-//! sees it through glass or in a mirror, the caustic store gathers, within the
-//! footprint of the pixel's ray cone (`½·pixel angle·path length`, bounded by the
-//! store's own radius). Without splats the store gathers at every diffuse hit, as in
-//! the paper.
+//! sees it through glass or in a mirror, the caustic store averages over the patch of
+//! surface the sample stands for: the parallelogram its ray differentials span there
+//! (Igehy 1999, carried through every reflection and refraction: magnified by a ball,
+//! stretched by a tube), bounded by the store's own radius — the pixel's box filter
+//! under the differentials' linearisation ([`Footprint`]). Without splats the store
+//! gathers at every diffuse hit, as in the paper.
 //!
 //! A pixel's value is the average radiance over its area (box filter). The default
 //! [`Sampling::Adaptive`] traces the pixel's four corners (Whitted 1980's adaptive
@@ -61,13 +63,15 @@ use heapless::Vec as FixedVec;
 use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
-use crate::math::{reflect, Rgb, UnitVec3};
-use crate::photon::{CausticStore, Splat};
+use crate::math::{reflect, Rgb, UnitVec3, Vec3};
+use crate::photon::{CausticStore, Footprint, Splat};
+use differential::Differential;
 
+mod differential;
 mod estimate;
 mod pixels;
 
-use crate::scene::Scene;
+use crate::scene::{Object, Scene};
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
 
@@ -134,9 +138,9 @@ enum Gather {
     Splatted,
     /// The store's own gather, as its settings say (the paper's way, without splats).
     Store,
-    /// Every photon within this radius, the footprint of the ray's cone (behind glass
-    /// and mirrors, with splats).
-    Footprint(f32),
+    /// The photons within the patch the sample stands for, from its ray differentials
+    /// (behind glass and mirrors, with splats).
+    Footprint(Footprint),
 }
 
 /// One pending branch of an eye path.
@@ -145,13 +149,9 @@ struct Branch {
     ray: Ray,
     weight: Rgb,
     depth: u32,
-    /// Distance travelled from the eye to the ray's origin.
-    travelled: f32,
-    /// Gather radius per unit of distance travelled: half the angle the sample stands
-    /// for (its pixel's, or its sub-pixel's in a grid).
-    spread: f32,
-    /// Rays of the pixel's grid that share its gather budget (`m²`; 1 for one ray).
-    share: u32,
+    /// How the ray moves across the sample's extent on the image (its pixel, or its
+    /// sub-pixel in a grid).
+    diff: Differential,
 }
 
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
@@ -190,8 +190,6 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     /// The camera's splats, when the forward pass made them: then the store gathers
     /// only at diffuse points seen through glass or mirrors.
     splats: Option<&'a [Splat]>,
-    /// Gather radius per unit of path length (`½·pixel angle·shrink`).
-    footprint: f32,
     /// Branches whose weight's largest channel is below this are not traced.
     cutoff: f32,
     /// Most rays (eye and shadow) per pixel.
@@ -221,7 +219,6 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             max_depth,
             sampling: Sampling::Centre,
             splats: None,
-            footprint: 0.5 * scene.camera().pixel_angle(),
             cutoff: DEFAULT_CUTOFF,
             ray_budget: DEFAULT_RAY_BUDGET,
             rays_per_hit: 1 + lit.count() as u32,
@@ -260,12 +257,6 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// all at once with [`add_to_frame`](crate::photon::add_to_frame)).
     pub fn with_splats(mut self, splats: &'a [Splat]) -> Self {
         self.splats = Some(splats);
-        self
-    }
-
-    /// Scales the gather footprint (progressive passes shrink it with the radius).
-    pub fn with_footprint_scale(mut self, scale: f32) -> Self {
-        self.footprint = 0.5 * self.scene.camera().pixel_angle() * scale;
         self
     }
 
@@ -308,17 +299,18 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// As [`sample`](Self::sample), for one ray of an `m × m` grid over the pixel: the
-    /// gathers behind glass stay within its sub-pixel's footprint.
+    /// gathers behind glass average over its sub-pixel's patch of surface.
     pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
+        let [dx, dy] = self.scene.camera().direction_derivatives(ray.dir);
+
+        let step = 1.0 / m.max(1) as f32;
         let mut next = Some(Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
-            travelled: 0.0,
-            spread: self.footprint / m.max(1) as f32,
-            share: m.max(1) * m.max(1),
+            diff: Differential::camera([dx * step, dy * step]),
         });
         let limit = count.eye + count.shadow + self.ray_budget as u64;
         while let Some(b) = next.take().or_else(|| stack.pop()) {
@@ -332,8 +324,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 continue;
             };
             out.mix(index as u32 | b.depth << 16);
-            let material = &self.scene.objects()[index].material;
-            let (local, mut first, mut second) = self.scatter(&b, &hit, material, count, &mut out);
+            let object = &self.scene.objects()[index];
+            let (local, mut first, mut second) = self.scatter(&b, &hit, object, count, &mut out);
             out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
@@ -351,13 +343,21 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         out
     }
 
-    /// How the caustic store gathers at a diffuse point reached by branch `b`.
+    /// How the caustic store gathers at the diffuse point `hit` reached by branch `b`:
+    /// behind glass or a mirror, over the parallelogram spanned by the half-steps of
+    /// the branch's differentials there.
     #[inline]
     fn gather(&self, b: &Branch, hit: &Hit) -> Gather {
         match self.splats {
             None => Gather::Store,
             Some(_) if b.depth == 0 => Gather::Splatted,
-            Some(_) => Gather::Footprint(b.spread * (b.travelled + hit.t)),
+            Some(_) => {
+                let at = b.diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
+                Gather::Footprint(Footprint {
+                    a: at.dp[0] * 0.5,
+                    b: at.dp[1] * 0.5,
+                })
+            }
         }
     }
 
@@ -368,7 +368,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         &self,
         b: &Branch,
         hit: &Hit,
-        material: &Material,
+        object: &Object,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> (Rgb, Option<Branch>, Option<Branch>) {
@@ -377,25 +377,20 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let facing = if front { hit.normal } else { -hit.normal };
         let can_bounce = b.depth < self.max_depth;
         // Negligible throughput: not traced (see the module documentation).
-        let branch = |dir: UnitVec3, w: Rgb| {
-            (!w.is_black() && w.max_channel() >= self.cutoff).then(|| Branch {
-                ray: Ray::spawn(hit, dir),
-                weight: w,
-                depth: b.depth + 1,
-                travelled: b.travelled + hit.t,
-                spread: b.spread,
-                share: b.share,
-            })
+        let traced = |w: Rgb| !w.is_black() && w.max_channel() >= self.cutoff;
+        let branch = |dir: UnitVec3, weight: Rgb, diff: Differential| Branch {
+            ray: Ray::spawn(hit, dir),
+            weight,
+            depth: b.depth + 1,
+            diff,
         };
-        match material {
+        match &object.material {
             Material::Diffuse(m) => {
                 if !front {
                     return (Rgb::ZERO, None, None);
                 }
                 let caustic = match self.gather(b, hit) {
-                    Gather::Footprint(r) => self
-                        .store
-                        .irradiance_within(hit.point, hit.normal, r, b.share),
+                    Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
                     Gather::Store => self.store.irradiance(hit.point, hit.normal),
                     Gather::Splatted => Rgb::ZERO,
                 };
@@ -411,11 +406,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
                 (f * e * core::f32::consts::FRAC_1_PI, None, None)
             }
-            Material::Mirror(m) if can_bounce => (
-                Rgb::ZERO,
-                branch(reflect(d, facing), b.weight * m.reflectance),
-                None,
-            ),
+            Material::Mirror(m) if can_bounce => {
+                let w = b.weight * m.reflectance;
+                let reflected = traced(w).then(|| {
+                    let turn = Turn::at(b, hit, object, facing);
+                    branch(reflect(d, facing), w, turn.reflect())
+                });
+                (Rgb::ZERO, reflected, None)
+            }
             Material::Dielectric(g) if can_bounce => {
                 let weight = if front {
                     b.weight
@@ -424,10 +422,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 };
                 let eta = if front { 1.0 / g.ior } else { g.ior };
                 let i = interface(d, facing, eta);
-                let reflected = branch(reflect(d, facing), weight * i.reflectance);
+                let turn = Turn::at(b, hit, object, facing);
+                let w = weight * i.reflectance;
+                let reflected = traced(w).then(|| branch(reflect(d, facing), w, turn.reflect()));
+                let w = weight * ((1.0 - i.reflectance) * eta * eta);
                 let refracted = i
                     .refracted
-                    .and_then(|t| branch(t, weight * ((1.0 - i.reflectance) * eta * eta)));
+                    .filter(|_| traced(w))
+                    .map(|t| branch(t, w, turn.refract(t, eta)));
                 (Rgb::ZERO, reflected, refracted)
             }
             Material::Classic(c) => {
@@ -441,9 +443,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
-                let reflected = branch(r, b.weight * c.reflectivity);
-                let t = interface(d, facing, eta).refracted.unwrap_or(r);
-                let refracted = branch(t, b.weight * c.transparency);
+                let turn = Turn::at(b, hit, object, facing);
+                let w = b.weight * c.reflectivity;
+                let reflected = traced(w).then(|| branch(r, w, turn.reflect()));
+                let w = b.weight * c.transparency;
+                let refracted = traced(w).then(|| match interface(d, facing, eta).refracted {
+                    Some(t) => branch(t, w, turn.refract(t, eta)),
+                    None => branch(r, w, turn.reflect()),
+                });
                 (b.weight * local, reflected, refracted)
             }
             // A specular surface after max_depth interactions contributes nothing.
@@ -472,10 +479,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         let caustic = match self.gather(b, hit) {
-            Gather::Footprint(r) => {
-                self.store
-                    .classic_within(hit.point, n, to_eye, c, (r, b.share))
-            }
+            Gather::Footprint(f) => self.store.classic_within(hit.point, n, to_eye, c, &f),
             Gather::Store => self.store.classic(hit.point, n, to_eye, c),
             Gather::Splatted => Rgb::ZERO,
         };
@@ -511,5 +515,43 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             return None;
         }
         Some((l, light.intensity() * (1.0 / d2)))
+    }
+}
+
+/// A branch's differentials at a specular hit, with the facing normal and its turn
+/// across the sample: what the reflected and refracted branches' differentials need.
+struct Turn {
+    at: Differential,
+    d: Vec3,
+    n: Vec3,
+    dn: [Vec3; 2],
+}
+
+impl Turn {
+    /// Transfers `b`'s differentials to `hit` on `object`, whose normal facing the ray
+    /// is `facing`.
+    #[inline]
+    fn at(b: &Branch, hit: &Hit, object: &Object, facing: UnitVec3) -> Self {
+        let d = b.ray.dir.get();
+        let at = b.diff.transfer(d, hit.t, hit.normal.get());
+        // The outward normal's turn, flipped with the normal when the ray is inside.
+        let sign = if facing == hit.normal { 1.0 } else { -1.0 };
+        let turn = |i: usize| object.shape.normal_derivative(hit.normal, at.dp[i]) * sign;
+        Self {
+            at,
+            d,
+            n: facing.get(),
+            dn: [turn(0), turn(1)],
+        }
+    }
+
+    #[inline]
+    fn reflect(&self) -> Differential {
+        self.at.reflect(self.d, self.n, self.dn)
+    }
+
+    #[inline]
+    fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
+        self.at.refract(self.d, t.get(), self.n, self.dn, eta)
     }
 }

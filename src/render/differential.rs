@@ -1,0 +1,196 @@
+//! Ray differentials: how an eye ray's point and direction change across the image
+//! (Igehy 1999, "Tracing Ray Differentials"; pbrt-v4 §10.1), carried through every
+//! mirror reflection and refraction so that a diffuse point seen through glass knows
+//! the patch of surface its pixel covers there — magnified by a ball, stretched along
+//! one axis by a tube — and the caustic store averages over exactly that patch.
+//!
+//! With `D` the unit direction, `N` the normal facing the ray (`D·N < 0`) and `∂` a
+//! derivative along the image's x or y:
+//! - **transfer** to a hit at distance `t`: `∂P' = ∂P + t·∂D + ∂t·D`,
+//!   `∂t = −(∂P + t·∂D)·N / (D·N)` (the point stays on the surface);
+//! - **reflection** `R = D − 2(D·N)N`: `∂R = ∂D − 2((D·N)·∂N + ∂(D·N)·N)`;
+//! - **refraction** `T = η·D − μ·N`, `μ = η(D·N) − T·N`, `η = η_i/η_t`:
+//!   `∂T = η·∂D − (μ·∂N + ∂μ·N)`, `∂μ = (η − η²(D·N)/(T·N))·∂(D·N)`;
+//!
+//! with `∂(D·N) = ∂D·N + D·∂N` and `∂N` from the shape
+//! ([`Shape::normal_derivative`](crate::geometry::Shape::normal_derivative)).
+
+use crate::math::Vec3;
+
+/// The derivatives of a ray's origin and direction along the image's x and y, per step
+/// of the sample's extent on the image (a pixel, or a sub-pixel of a grid).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Differential {
+    /// `∂P/∂x`, `∂P/∂y`.
+    pub dp: [Vec3; 2],
+    /// `∂D/∂x`, `∂D/∂y`.
+    pub dd: [Vec3; 2],
+}
+
+impl Differential {
+    /// A pinhole camera ray: the origin is fixed, the direction turns by `dd`.
+    #[inline]
+    pub fn camera(dd: [Vec3; 2]) -> Self {
+        Self {
+            dp: [Vec3::ZERO; 2],
+            dd,
+        }
+    }
+
+    /// The differentials at a hit `t` along direction `d`, on a surface of normal `n`
+    /// (either orientation): the direction's are unchanged.
+    #[inline]
+    pub fn transfer(&self, d: Vec3, t: f32, n: Vec3) -> Self {
+        let dn = d.dot(n);
+        let dp = |i: usize| {
+            let moved = self.dp[i] + self.dd[i] * t;
+            moved - d * (moved.dot(n) / dn)
+        };
+        Self {
+            dp: [dp(0), dp(1)],
+            dd: self.dd,
+        }
+    }
+
+    /// The reflected ray's, about the normal `n` facing `d` that turns by `dn`.
+    #[inline]
+    pub fn reflect(&self, d: Vec3, n: Vec3, dn: [Vec3; 2]) -> Self {
+        let d_n = d.dot(n);
+        let dd = |i: usize| {
+            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
+            self.dd[i] - (dn[i] * d_n + n * dd_n) * 2.0
+        };
+        Self {
+            dp: self.dp,
+            dd: [dd(0), dd(1)],
+        }
+    }
+
+    /// The refracted ray's (direction `t_dir`), about the normal `n` facing `d` that
+    /// turns by `dn`, with `eta = η_i/η_t`.
+    #[inline]
+    pub fn refract(&self, d: Vec3, t_dir: Vec3, n: Vec3, dn: [Vec3; 2], eta: f32) -> Self {
+        let (d_n, t_n) = (d.dot(n), t_dir.dot(n));
+        let mu = eta * d_n - t_n;
+        let dmu_per = eta - eta * eta * d_n / t_n;
+        let dd = |i: usize| {
+            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
+            self.dd[i] * eta - (dn[i] * mu + n * (dmu_per * dd_n))
+        };
+        Self {
+            dp: self.dp,
+            dd: [dd(0), dd(1)],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::geometry::{Ray, Shape};
+    use crate::material::interface;
+    use crate::math::reflect;
+
+    /// Follows `ray` through `specular` in order (refracting into or out of glass of
+    /// index 1.5, or reflecting where the flag says mirror) and on to `floor`: the point
+    /// there and the differentials carried along; `None` when the ray misses a surface
+    /// or totally reflects.
+    fn follow(
+        ray: Ray,
+        diff: Differential,
+        specular: &[(Shape, bool)],
+        floor: &Shape,
+    ) -> Option<(Vec3, Differential)> {
+        let (mut ray, mut diff) = (ray, diff);
+        for (shape, mirror) in specular {
+            let hit = shape.intersect(&ray, f32::INFINITY)?;
+            let d = ray.dir;
+            let front = hit.front_face(d);
+            let facing = if front { hit.normal } else { -hit.normal };
+            let at = diff.transfer(d.get(), hit.t, hit.normal.get());
+            let sign = if front { 1.0 } else { -1.0 };
+            let dn = [0, 1].map(|i| shape.normal_derivative(hit.normal, at.dp[i]) * sign);
+            let (dir, next) = if *mirror {
+                let r = reflect(d, facing);
+                (r, at.reflect(d.get(), facing.get(), dn))
+            } else {
+                let eta = if front { 1.0 / 1.5 } else { 1.5 };
+                let t = interface(d, facing, eta).refracted?;
+                (t, at.refract(d.get(), t.get(), facing.get(), dn, eta))
+            };
+            ray = Ray::spawn(&hit, dir);
+            diff = next;
+        }
+        let hit = floor.intersect(&ray, f32::INFINITY)?;
+        Some((
+            hit.point,
+            diff.transfer(ray.dir.get(), hit.t, hit.normal.get()),
+        ))
+    }
+
+    /// The differentials carried through curved glass (into and out of a sphere, of a
+    /// cylinder's side) and off a curved mirror predict where the neighbouring rays of
+    /// the image land on the floor: over every pixel of a coarse grid whose ray gets
+    /// there, central finite differences of the traced points agree with `∂P` to 2%
+    /// of its length at all but 1% of them (a ray grazing a surface), the median to 0.1%.
+    #[test]
+    fn differentials_match_finite_differences_through_glass_and_mirrors() {
+        let camera = Camera::new(
+            Vec3::new(0.0, 2.0, 6.0),
+            Vec3::new(0.0, 0.5, 0.0),
+            Vec3::Y,
+            40.0,
+            320,
+            240,
+        )
+        .unwrap();
+        let floor = Shape::plane(Vec3::new(0.0, 0.0, -3.0), Vec3::Z).unwrap();
+        let ball = Shape::sphere(Vec3::new(0.0, 0.8, 0.0), 0.8).unwrap();
+        let tube = Shape::cylinder(Vec3::new(-1.0, 0.8, 0.0), Vec3::X, 0.6, 2.0, false).unwrap();
+        let mirror = Shape::sphere(Vec3::new(0.0, 0.8, 0.0), 0.9).unwrap();
+        let back_wall = Shape::plane(Vec3::new(0.0, 0.0, 8.0), -Vec3::Z).unwrap();
+        let setups: [(&[(Shape, bool)], &Shape); 3] = [
+            (&[(ball, false), (ball, false)], &floor),
+            (&[(tube, false), (tube, false)], &floor),
+            (&[(mirror, true)], &back_wall),
+        ];
+        for (specular, target) in setups {
+            let mut errors = std::vec::Vec::new();
+            for py in (4..240).step_by(8) {
+                for px in (4..320).step_by(8) {
+                    let at = |x: f32, y: f32| camera.ray_at(px, py, x, y);
+                    let ray = at(0.5, 0.5);
+                    let diff = Differential::camera(camera.direction_derivatives(ray.dir));
+                    let Some((_, d)) = follow(ray, diff, specular, target) else {
+                        continue;
+                    };
+                    let h = 1e-2;
+                    for (i, (dx, dy)) in [(h, 0.0), (0.0, h)].into_iter().enumerate() {
+                        let end =
+                            |s: f32| follow(at(0.5 + s * dx, 0.5 + s * dy), diff, specular, target);
+                        let (Some((plus, _)), Some((minus, _))) = (end(1.0), end(-1.0)) else {
+                            continue;
+                        };
+                        let fd = (plus - minus) / (2.0 * h);
+                        errors.push((fd - d.dp[i]).length() / fd.length());
+                    }
+                }
+            }
+            errors.sort_by(f32::total_cmp);
+            assert!(
+                errors.len() >= 50,
+                "{} pixels reach the target",
+                errors.len()
+            );
+            let median = errors[errors.len() / 2];
+            // Central differences break down only where a ray grazes a surface.
+            let tail = errors.iter().filter(|&&e| e > 0.02).count();
+            assert!(
+                median < 1e-3 && tail * 100 <= errors.len(),
+                "median {median}, {tail} of {} above 2%",
+                errors.len()
+            );
+        }
+    }
+}
