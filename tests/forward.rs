@@ -254,6 +254,7 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
 #[test]
 fn the_parallel_forward_pass_is_the_serial_one() {
     use caustic::desktop::photons::PhotonBuffer;
+    use caustic::desktop::progress::Progress;
     use caustic::desktop::RenderStats;
     let text = scene_text("two_balls.json");
     let scene = parse_scene(&text).unwrap().scene;
@@ -263,8 +264,16 @@ fn the_parallel_forward_pass_is_the_serial_one() {
     assert!(serial.len() > 1 << 15, "{}", serial.len());
     for threads in [1, 3] {
         let mut buf = PhotonBuffer::for_budget(&scene, &s).unwrap();
-        buf.fill(&scene, &s, 9, 0, threads, &mut RenderStats::default())
-            .unwrap();
+        buf.fill(
+            &scene,
+            &s,
+            9,
+            0,
+            threads,
+            &mut RenderStats::default(),
+            &Progress::hidden(),
+        )
+        .unwrap();
         assert_eq!(buf.unit(), unit);
         assert_eq!(buf.tree().photons(), &serial[..], "{threads} threads");
     }

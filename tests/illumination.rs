@@ -432,6 +432,7 @@ fn a_layout_beyond_the_texel_budget_is_coarsened_to_fit() {
 #[test]
 fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     use caustic::desktop::photons::PhotonBuffer;
+    use caustic::desktop::progress::Progress;
     use caustic::desktop::{RenderStats, MAX_GATHER, MAX_OBJECTS};
     use caustic::photon::DEFAULT_HEAP_TEXELS;
 
@@ -496,7 +497,15 @@ fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     };
     let mut photons = PhotonBuffer::for_budget(scene, settings).unwrap();
     photons
-        .fill(scene, settings, 7, 0, 2, &mut RenderStats::default())
+        .fill(
+            scene,
+            settings,
+            7,
+            0,
+            2,
+            &mut RenderStats::default(),
+            &Progress::hidden(),
+        )
         .unwrap();
     let kd = photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), settings).unwrap();
     let (e_maps, e_kd) = (integral(&maps), integral(&kd));

@@ -183,7 +183,7 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
     let mut stats = caustic::desktop::RenderStats::default();
     let mut photons = PhotonBuffer::for_budget(&scene, &settings).unwrap();
     photons
-        .fill(&scene, &settings, 1, 0, 2, &mut stats)
+        .fill(&scene, &settings, 1, 0, 2, &mut stats, &Progress::hidden())
         .unwrap();
     let store = photon::store_over::<128>(photons.tree(), photons.unit(), &settings).unwrap();
     let image = |cutoff: f32, budget: u32| {

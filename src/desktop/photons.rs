@@ -112,25 +112,12 @@ impl PhotonBuffer {
     }
 
     /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
-    /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// `CHUNK` and kept in emission order: the same array as the core's
+    /// adding the times and counts to `stats` and showing its two phases (photons,
+    /// balance) on `progress` ([`Progress::hidden`] for none). The photons are traced in
+    /// chunks of `CHUNK` and kept in emission order: the same array as the core's
     /// [`photon::shoot`], whatever the thread count.
-    pub fn fill<const O: usize, const L: usize>(
-        &mut self,
-        scene: &Scene<O, L>,
-        settings: &PhotonSettings,
-        seed: u64,
-        pass: u32,
-        threads: usize,
-        stats: &mut RenderStats,
-    ) -> Result<(), Error> {
-        let hidden = Progress::new(false, 1);
-        self.fill_with_progress(scene, settings, seed, pass, threads, stats, &hidden)
-    }
-
-    /// [`PhotonBuffer::fill`], showing its two phases (photons, balance) on `progress`.
     #[allow(clippy::too_many_arguments)]
-    pub fn fill_with_progress<const O: usize, const L: usize>(
+    pub fn fill<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,

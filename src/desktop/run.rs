@@ -338,7 +338,7 @@ pub fn render_with_error(
         // Knaus & Zwicker (2011): r_i² = r_1²·i^(α−1), i = 1, 2, …
         let shrink = libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0));
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
-        photons.fill_with_progress(
+        photons.fill(
             scene,
             &pass_settings,
             opts.seed,
