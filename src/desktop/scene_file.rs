@@ -289,6 +289,15 @@ fn type_of<'v>(v: &'v Value, path: &str, allowed: &[&str]) -> Result<&'v str, Sc
     }
 }
 
+/// The list `key` (`lights`, `objects`) holds at most `max` entries.
+fn at_most(list: &[Value], max: usize, key: &str) -> Result<(), SceneError> {
+    if list.len() > max {
+        let message = format!("{} {key}, at most {max} are supported", list.len());
+        return Err(err(key, message));
+    }
+    Ok(())
+}
+
 fn v3(a: [f32; 3]) -> Vec3 {
     Vec3::from_array(a)
 }
@@ -357,15 +366,7 @@ fn camera(c: &CameraDef, image: Option<&ImageDef>) -> Result<Camera, SceneError>
 }
 
 fn add_lights(scene: &mut DesktopScene, lights: &[Value]) -> Result<(), SceneError> {
-    if lights.len() > MAX_LIGHTS {
-        return Err(err(
-            "lights",
-            format!(
-                "{} lights, at most {MAX_LIGHTS} are supported",
-                lights.len()
-            ),
-        ));
-    }
+    at_most(lights, MAX_LIGHTS, "lights")?;
     for (i, v) in lights.iter().enumerate() {
         let path = format!("lights[{i}]");
         type_of(v, &path, &["point"])?;
@@ -484,15 +485,7 @@ fn add_objects(
     objects: &[Value],
     materials: &BTreeMap<String, Material>,
 ) -> Result<(), SceneError> {
-    if objects.len() > MAX_OBJECTS {
-        return Err(err(
-            "objects",
-            format!(
-                "{} objects, at most {MAX_OBJECTS} are supported",
-                objects.len()
-            ),
-        ));
-    }
+    at_most(objects, MAX_OBJECTS, "objects")?;
     for (i, v) in objects.iter().enumerate() {
         let path = format!("objects[{i}]");
         let (shape, material) = shape(v, &path)?;
