@@ -141,97 +141,37 @@ pub struct PhotonsDef {
     pub gather: Option<String>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PointLightDef {
-    #[serde(rename = "type")]
-    _type: String,
-    position: [f32; 3],
-    intensity: [f32; 3],
+/// The typed objects of the scene format (`{"type": …, fields}`), one line each: a
+/// struct of the fields that also takes the `type` key (its value is checked first, by
+/// [`type_of`]) and refuses any other key.
+macro_rules! typed_objects {
+    ($($name:ident { $($field:ident: $ty:ty),* $(,)? })*) => {$(
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct $name {
+            #[serde(rename = "type")]
+            _type: String,
+            $($field: $ty,)*
+        }
+    )*};
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DiffuseDef {
-    #[serde(rename = "type")]
-    _type: String,
-    albedo: [f32; 3],
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MirrorDef {
-    #[serde(rename = "type")]
-    _type: String,
-    reflectance: Option<[f32; 3]>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DielectricDef {
-    #[serde(rename = "type")]
-    _type: String,
-    ior: f32,
-    absorption: Option<[f32; 3]>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ClassicDef {
-    #[serde(rename = "type")]
-    _type: String,
-    color: [f32; 3],
-    ambient: f32,
-    diffuse: f32,
-    specular: f32,
-    shininess: f32,
-    reflectivity: f32,
-    transparency: f32,
-    ior: f32,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PlaneDef {
-    #[serde(rename = "type")]
-    _type: String,
-    point: [f32; 3],
-    normal: [f32; 3],
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SphereDef {
-    #[serde(rename = "type")]
-    _type: String,
-    center: [f32; 3],
-    radius: f32,
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct BoxDef {
-    #[serde(rename = "type")]
-    _type: String,
-    center: [f32; 3],
-    size: [f32; 3],
-    rotation_deg: Option<[f32; 3]>,
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CylinderDef {
-    #[serde(rename = "type")]
-    _type: String,
-    base: [f32; 3],
-    axis: [f32; 3],
-    radius: f32,
-    height: f32,
-    capped: Option<bool>,
-    material: String,
+typed_objects! {
+    PointLightDef { position: [f32; 3], intensity: [f32; 3] }
+    DiffuseDef { albedo: [f32; 3] }
+    MirrorDef { reflectance: Option<[f32; 3]> }
+    DielectricDef { ior: f32, absorption: Option<[f32; 3]> }
+    ClassicDef {
+        color: [f32; 3], ambient: f32, diffuse: f32, specular: f32, shininess: f32,
+        reflectivity: f32, transparency: f32, ior: f32,
+    }
+    PlaneDef { point: [f32; 3], normal: [f32; 3], material: String }
+    SphereDef { center: [f32; 3], radius: f32, material: String }
+    BoxDef { center: [f32; 3], size: [f32; 3], rotation_deg: Option<[f32; 3]>, material: String }
+    CylinderDef {
+        base: [f32; 3], axis: [f32; 3], radius: f32, height: f32, capped: Option<bool>,
+        material: String,
+    }
 }
 
 /// A scene file, read and validated.
