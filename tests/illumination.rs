@@ -17,7 +17,7 @@ use caustic::photon::{
     PhotonSettings,
 };
 use caustic::scene::Scene;
-use support::{data_text, scene_text};
+use support::{add_light, data_text, scene_text, worst_floor_irradiance_error};
 
 type Maps = IlluminationMaps<Vec<Rgb>, 8>;
 
@@ -101,9 +101,7 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
     scene
         .add(Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(), diffuse())
         .unwrap();
-    scene
-        .add_light(PointLight::new(light, Rgb::splat(intensity)).unwrap())
-        .unwrap();
+    add_light(&mut scene, light, Rgb::splat(intensity));
     let settings = PhotonSettings::new(400_000, 64, 0.5, 4)
         .unwrap()
         .with_direct_photons(true);
@@ -116,16 +114,9 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
     let (forward, stats) = maps.build(&scene, &settings, 11).unwrap();
     assert!(forward.stored > 190_000);
     eprintln!("direct: {:?}", stats);
-    let mut worst = 0.0f64;
-    for i in 0..40 {
-        let a = i as f32 * 0.61;
-        let r = 0.02 * i as f32;
-        let x = Vec3::new(r * a.cos(), 0.0, r * a.sin());
-        let e = maps.irradiance(x, UnitVec3::Y).r as f64;
-        let to = (light - x).as_dvec3();
-        let want = intensity as f64 * (to.y / to.length()) / to.length_squared();
-        worst = worst.max((e - want).abs() / want);
-    }
+    let worst = worst_floor_irradiance_error(light, intensity, 0.02, |x| {
+        maps.irradiance(x, UnitVec3::Y).r as f64
+    });
     eprintln!("direct: worst relative error {:.3}%", worst * 100.0);
     assert!(worst < 0.03, "worst {worst}");
 }

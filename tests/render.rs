@@ -11,7 +11,6 @@ use caustic::desktop::run::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
 use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Ray, Shape};
-use caustic::light::PointLight;
 use caustic::material::Classic;
 use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
@@ -20,7 +19,7 @@ use caustic::photon::{NoCaustics, PhotonSettings};
 use caustic::render::PixelEstimate;
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
-use support::scene_text;
+use support::{add_floor, add_glass_sphere, add_light, scene_text};
 
 /// A diffuse floor of albedo ρ under a point light: every pixel that sees the floor has
 /// radiance ρ·I·cosθ/(π·d²), evaluated here in f64 from the analytic ray–plane hit.
@@ -37,15 +36,8 @@ fn direct_light_on_a_diffuse_floor_is_analytic() {
     )
     .unwrap();
     let mut scene: Scene<1, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::splat(albedo)).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(light, intensity).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::splat(albedo));
+    add_light(&mut scene, light, intensity);
     let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     let mut worst = 0.0f64;
     let mut seen = 0;
@@ -117,21 +109,9 @@ fn refraction_through_a_slab_exits_parallel() {
 fn glass_casts_a_shadow_for_direct_light() {
     let camera = Camera::new(Vec3::new(0.0, 5.0, 0.001), Vec3::ZERO, Vec3::Y, 10.0, 9, 9).unwrap();
     let mut scene: Scene<2, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add(
-            Shape::sphere(Vec3::new(5.0, 2.0, 0.0), 0.5).unwrap(),
-            Material::dielectric(1.5, Rgb::ZERO).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(10.0, 4.0, 0.0), Rgb::ONE).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
+    add_glass_sphere(&mut scene, Vec3::new(5.0, 2.0, 0.0), 0.5);
+    add_light(&mut scene, Vec3::new(10.0, 4.0, 0.0), Rgb::ONE);
     let r: Renderer<_, 2, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     // The floor point (0,0,0) lies exactly behind the sphere as seen from the light.
     let down = Ray::new(Vec3::new(0.0, 1.0, 0.0), -UnitVec3::Y);
@@ -259,12 +239,8 @@ fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
             walls,
         )
         .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(0.5, 1.0, 0.0), Rgb::splat(5.0)).unwrap())
-        .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(-1.0, -1.0, -1.0), Rgb::splat(2.0)).unwrap())
-        .unwrap();
+    add_light(&mut scene, Vec3::new(0.5, 1.0, 0.0), Rgb::splat(5.0));
+    add_light(&mut scene, Vec3::new(-1.0, -1.0, -1.0), Rgb::splat(2.0));
     for (cutoff, budget) in [
         (0.0, 300),
         (0.0, DEFAULT_RAY_BUDGET),
@@ -310,12 +286,7 @@ fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
 fn rows_refuses_a_short_row_buffer() {
     let camera = Camera::new(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0, 8, 2).unwrap();
     let mut scene: Scene<1, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
     let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     let mut short = [Rgb::ZERO; 7];
     let mut called = false;
