@@ -26,15 +26,7 @@ use support::{add_floor, add_glass_sphere, add_light, scene_text};
 #[test]
 fn direct_light_on_a_diffuse_floor_is_analytic() {
     let (albedo, intensity, light) = (0.63f32, Rgb::new(10.0, 5.0, 2.5), Vec3::new(0.4, 2.5, -0.3));
-    let camera = Camera::new(
-        Vec3::new(0.0, 3.0, 4.0),
-        Vec3::new(0.0, 0.0, -1.0),
-        Vec3::Y,
-        50.0,
-        48,
-        36,
-    )
-    .unwrap();
+    let camera = Camera::new(Vec3::new(0.0, 3.0, 4.0), Vec3::NEG_Z, Vec3::Y, 50.0, 48, 36).unwrap();
     let mut scene: Scene<1, 1> = Scene::new(camera);
     add_floor(&mut scene, Rgb::splat(albedo));
     add_light(&mut scene, light, intensity);
@@ -68,12 +60,7 @@ fn direct_light_on_a_diffuse_floor_is_analytic() {
 /// A ray through a parallel glass slab leaves parallel to how it came in, displaced.
 #[test]
 fn refraction_through_a_slab_exits_parallel() {
-    let slab = Shape::cuboid(
-        Vec3::ZERO,
-        Vec3::new(100.0, 0.5, 100.0),
-        Vec3::new(0.0, 0.0, 0.0),
-    )
-    .unwrap();
+    let slab = Shape::cuboid(Vec3::ZERO, Vec3::new(100.0, 0.5, 100.0), Vec3::ZERO).unwrap();
     for (i, angle) in [0.0f32, 0.2, 0.5, 0.9, 1.3].into_iter().enumerate() {
         let d = UnitVec3::new(Vec3::new(angle.sin(), -angle.cos(), 0.1 * i as f32)).unwrap();
         let ray = Ray::new(Vec3::new(0.0, 2.0, 0.0), d);
@@ -200,15 +187,7 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
 /// most of it; with the default cut-off too.
 #[test]
 fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
-    let camera = Camera::new(
-        Vec3::new(0.0, 0.0, 0.5),
-        Vec3::new(0.0, 0.0, -1.0),
-        Vec3::Y,
-        60.0,
-        16,
-        12,
-    )
-    .unwrap();
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 0.5), Vec3::NEG_Z, Vec3::Y, 60.0, 16, 12).unwrap();
     let mut scene: Scene<8, 2> = Scene::new(camera);
     let glassy = Material::classic(Classic::new(
         Rgb::splat(0.9),
