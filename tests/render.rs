@@ -668,6 +668,18 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// Runs `command`, asserts that it succeeded (else shows its stderr) and parses its
+/// stdout as JSON.
+fn json_stdout(command: &mut std::process::Command) -> serde_json::Value {
+    let out = command.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 /// The program renders what the library renders: its PFM holds the library's bits, its
 /// `--stats` the sizes and counts, and `compare` measures a known difference.
 #[test]
@@ -677,31 +689,25 @@ fn the_program_writes_the_library_image_and_compares_it() {
     let exe = env!("CARGO_BIN_EXE_caustic");
     let scene = format!("{}/scenes/glass_sphere.json", env!("CARGO_MANIFEST_DIR"));
     let (png, pfm) = (dir.join("g.png"), dir.join("g.pfm"));
-    let out = std::process::Command::new(exe)
-        .args([
-            "render",
-            &scene,
-            "--width",
-            "40",
-            "--height",
-            "30",
-            "--photons",
-            "5000",
-            "--stats",
-            "--quiet",
-            "-o",
-        ])
-        .arg(&png)
-        .arg("--pfm")
-        .arg(&pfm)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let stats = json_stdout(
+        std::process::Command::new(exe)
+            .args([
+                "render",
+                &scene,
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "--photons",
+                "5000",
+                "--stats",
+                "--quiet",
+                "-o",
+            ])
+            .arg(&png)
+            .arg("--pfm")
+            .arg(&pfm),
     );
-    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(
         (stats["width"].as_u64(), stats["height"].as_u64()),
         (Some(40), Some(30))
@@ -734,18 +740,12 @@ fn the_program_writes_the_library_image_and_compares_it() {
     }
     let scaled_path = dir.join("scaled.pfm");
     scaled.write_pfm(&scaled_path).unwrap();
-    let cmp = std::process::Command::new(exe)
-        .args(["compare"])
-        .arg(&scaled_path)
-        .arg(&pfm)
-        .output()
-        .unwrap();
-    assert!(
-        cmp.status.success(),
-        "{}",
-        String::from_utf8_lossy(&cmp.stderr)
+    let c = json_stdout(
+        std::process::Command::new(exe)
+            .args(["compare"])
+            .arg(&scaled_path)
+            .arg(&pfm),
     );
-    let c: serde_json::Value = serde_json::from_slice(&cmp.stdout).unwrap();
     let values: Vec<f64> = img
         .pixels
         .iter()
