@@ -128,49 +128,58 @@ impl PhotonSettings {
     }
 
     /// With Jensen's cone filter.
-    pub fn with_cone_filter(mut self, cone: Option<ConeFilter>) -> Self {
-        self.cone = cone;
-        self
+    pub fn with_cone_filter(self, cone: Option<ConeFilter>) -> Self {
+        Self { cone, ..self }
+    }
+
+    /// The cone filter, if any.
+    pub fn cone_filter(&self) -> Option<ConeFilter> {
+        self.cone
     }
 
     /// Emits over the light's whole sphere instead of through projection maps
     /// (for measuring what the projection maps save).
-    pub fn with_full_sphere(mut self, full_sphere: bool) -> Self {
-        self.full_sphere = full_sphere;
-        self
+    pub fn with_full_sphere(self, full_sphere: bool) -> Self {
+        Self {
+            full_sphere,
+            ..self
+        }
     }
 
     /// Also stores photons at their first (direct) hit: the map then holds direct
     /// light too. For tests of the density estimate; never for rendering, where direct
     /// light comes from shadow rays.
-    pub fn with_direct_photons(mut self, store_direct: bool) -> Self {
-        self.store_direct = store_direct;
-        self
+    pub fn with_direct_photons(self, store_direct: bool) -> Self {
+        Self {
+            store_direct,
+            ..self
+        }
     }
 
     /// Gathers every photon within `max_radius` instead of the `k` nearest: the
     /// estimate of progressive photon mapping, whose radius shrinks pass by pass.
-    pub fn with_fixed_radius(mut self, fixed_radius: bool) -> Self {
-        self.fixed_radius = fixed_radius;
-        self
-    }
-
-    /// Whether the forward pass connects each landed photon to the eye (light tracing
-    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
-    /// backward pass gathers at every diffuse hit, as in the paper.
-    pub fn with_camera_splats(mut self, splat: bool) -> Self {
-        self.splat = splat;
-        self
-    }
-
-    /// `true` when landed photons are connected to the eye.
-    pub fn camera_splats(&self) -> bool {
-        self.splat
+    pub fn with_fixed_radius(self, fixed_radius: bool) -> Self {
+        Self {
+            fixed_radius,
+            ..self
+        }
     }
 
     /// `true` when every photon within `max_radius` is gathered.
     pub fn fixed_radius(&self) -> bool {
         self.fixed_radius
+    }
+
+    /// Whether the forward pass connects each landed photon to the eye (light tracing
+    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
+    /// backward pass gathers at every diffuse hit, as in the paper.
+    pub fn with_camera_splats(self, splat: bool) -> Self {
+        Self { splat, ..self }
+    }
+
+    /// `true` when landed photons are connected to the eye.
+    pub fn camera_splats(&self) -> bool {
+        self.splat
     }
 
     /// A copy with another maximum radius (progressive passes shrink it).
@@ -194,10 +203,6 @@ impl PhotonSettings {
     /// Specular interactions per path.
     pub fn max_depth(&self) -> u32 {
         self.max_depth
-    }
-    /// The cone filter, if any.
-    pub fn cone_filter(&self) -> Option<ConeFilter> {
-        self.cone
     }
 }
 
