@@ -251,7 +251,7 @@ where
 }
 
 /// The device's pipeline with the photon array on the heap (any `--photons`): the
-/// same forward pass ([`photon::shoot`], pass 0, then [`photon::balance`]) as
+/// same forward pass ([`photon::shoot_with_splats`], pass 0, then [`photon::balance`]) as
 /// `PhotonMap::build`, a gather of `K`, a path stack of `DEPTH`, one row buffer whose
 /// rows go to `sink(y, pixels)`.
 fn draw<const O: usize, const L: usize, const K: usize, const DEPTH: usize>(

@@ -24,7 +24,7 @@ fn photons<const O: usize, const L: usize>(
     seed: u64,
 ) -> (Vec<Photon>, f32, u64) {
     let mut buf = vec![Photon::ZERO; photon::photons_needed(scene, s)];
-    let f = photon::shoot(scene, s, seed, 0, &mut buf).unwrap();
+    let f = photon::shoot_with_splats(scene, s, seed, 0, &mut buf, &mut ()).unwrap();
     buf.truncate(f.stored);
     balance(&mut buf);
     (buf, f.power_unit, f.emitted)
@@ -220,11 +220,11 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
     add_light(&mut scene, Vec3::Y * 3.0, Rgb::ONE);
     let s = PhotonSettings::new(1000, 8, 0.1, 4).unwrap();
     let mut buf = vec![Photon::ZERO; 1000];
-    let f = photon::shoot(&scene, &s, 0, 0, &mut buf).unwrap();
+    let f = photon::shoot_with_splats(&scene, &s, 0, 0, &mut buf, &mut ()).unwrap();
     assert_eq!((f.emitted, f.stored), (0, 0));
     // A budget larger than the storage is an error, not a truncation.
     let mut small = vec![Photon::ZERO; 10];
-    assert!(photon::shoot(&scene, &s, 0, 0, &mut small).is_err());
+    assert!(photon::shoot_with_splats(&scene, &s, 0, 0, &mut small, &mut ()).is_err());
 }
 
 /// The desktop's parallel forward pass and balance give exactly the core's tree, on any

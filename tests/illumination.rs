@@ -1,6 +1,6 @@
 //! Illumination maps (Arvo; paper section 3.1) against analytic answers: flat maps
 //! from uniform flux, energy conservation, true texel areas, the single-photon round
-//! trip, determinism, and the streaming forward pass against `shoot`.
+//! trip, determinism, and the streaming forward pass against `shoot_with_splats`.
 
 mod support;
 
@@ -291,7 +291,7 @@ fn single_photon_round_trip_conserves_energy() {
 }
 
 /// The same seed gives the same bits; the streaming forward pass hands out exactly
-/// the photons `shoot` stores, so maps built either way are identical; and a fixed
+/// the photons `shoot_with_splats` stores, so maps built either way are identical; and a fixed
 /// array holds the same maps as a `Vec`.
 #[test]
 fn same_seed_same_bits_and_streaming_equals_stored() {
@@ -300,7 +300,7 @@ fn same_seed_same_bits_and_streaming_equals_stored() {
     let scene = &loaded.scene;
     let settings = PhotonSettings::new(5_000, 32, 0.1, 8).unwrap();
     let mut shot = vec![Photon::ZERO; photon::photons_needed(scene, &settings)];
-    let f = photon::shoot(scene, &settings, 9, 0, &mut shot).unwrap();
+    let f = photon::shoot_with_splats(scene, &settings, 9, 0, &mut shot, &mut ()).unwrap();
     shot.truncate(f.stored);
     let mut streamed = Vec::new();
     let g = for_each_photon(scene, &settings, 9, 0, |p| streamed.push(*p));

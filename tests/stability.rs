@@ -824,7 +824,7 @@ fn check_random_scene(seed: u64) -> Option<usize> {
         );
     }
     let mut photons = vec![Photon::ZERO; photon::photons_needed(&scene, &settings)];
-    let f = photon::shoot(&scene, &settings, seed, 0, &mut photons).unwrap();
+    let f = photon::shoot_with_splats(&scene, &settings, seed, 0, &mut photons, &mut ()).unwrap();
     let stored = photons[..f.stored]
         .iter()
         .fold(Rgb::ZERO, |a, p| a + p.power() * f.power_unit);
@@ -1058,7 +1058,7 @@ fn a_zero_power_light() {
     add_light(&mut scene, Vec3::new(0.0, 5.0, 0.0), Rgb::ZERO);
     let settings = PhotonSettings::new(1000, 16, 0.1, 8).unwrap();
     let mut photons = vec![Photon::ZERO; photon::photons_needed(&scene, &settings)];
-    let f = photon::shoot(&scene, &settings, 0, 0, &mut photons).unwrap();
+    let f = photon::shoot_with_splats(&scene, &settings, 0, 0, &mut photons, &mut ()).unwrap();
     assert_eq!(f.stored, 0);
     let (image, _) = render(
         &scene,
@@ -1079,7 +1079,15 @@ fn a_zero_power_light() {
         ..RenderOptions::default()
     };
     scene.add_light(bright).unwrap();
-    let f = photon::shoot(&scene, &settings, 0, 0, &mut vec![Photon::ZERO; 2000]).unwrap();
+    let f = photon::shoot_with_splats(
+        &scene,
+        &settings,
+        0,
+        0,
+        &mut vec![Photon::ZERO; 2000],
+        &mut (),
+    )
+    .unwrap();
     assert!(f.stored > 0 && f.power_unit.is_finite());
     assert_eq!(f.emitted, settings.count() as u64);
     let (image, stats) = render(&scene, &settings, &opts).unwrap();

@@ -115,7 +115,7 @@ impl PhotonBuffer {
     /// adding the times and counts to `stats` and showing its two phases (photons,
     /// balance) on `progress` ([`Progress::hidden`] for none). The photons are traced in
     /// chunks of `CHUNK` and kept in emission order: the same array as the core's
-    /// [`photon::shoot`], whatever the thread count.
+    /// [`photon::shoot_with_splats`], whatever the thread count.
     #[allow(clippy::too_many_arguments)]
     pub fn fill<const O: usize, const L: usize>(
         &mut self,

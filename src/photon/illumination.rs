@@ -309,8 +309,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// The forward pass of `settings` with `seed` (pass 0), run two or three times
     /// (layout, plane trim if any, splat) and splatted without storing a photon: the
-    /// memory is the maps' alone. Splats exactly the photons [`shoot`](super::shoot)
-    /// would store, in the same order.
+    /// memory is the maps' alone. Splats exactly the photons
+    /// [`shoot_with_splats`](super::shoot_with_splats) would store, in the same order.
     pub fn build<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,

@@ -7,7 +7,7 @@
 //! - `estimate`: the radiance estimate (Jensen; paper eq. 8).
 //!
 //! # Emission
-//! See the `emit` module's formulas, repeated on [`shoot`].
+//! See the `emit` module's formulas, repeated on [`shoot_with_splats`].
 
 mod emit;
 mod estimate;
@@ -427,7 +427,7 @@ pub fn forward<const O: usize, const L: usize>(
     Ok(stats)
 }
 
-/// The forward pass of [`shoot`], handing each photon it would store to `f` instead of
+/// The forward pass of [`shoot_with_splats`], handing each photon it would store to `f` instead of
 /// writing it to an array: the same photons, in the same order, with the same power
 /// unit. Needs no photon memory at all (the illumination maps splat as they go).
 pub fn for_each_photon<const O: usize, const L: usize>(
@@ -447,20 +447,9 @@ pub fn for_each_photon<const O: usize, const L: usize>(
 
 /// The forward pass: shoots `settings.count` photons from each light (see [`Emitter`])
 /// and stores those that land on a diffuse surface after a specular bounce, in
-/// emission order, into `out[..stored]` (not yet balanced). An error when `out` cannot
-/// hold `count × lights` photons. Camera splats are not kept: see [`shoot_with_splats`].
-pub fn shoot<const O: usize, const L: usize>(
-    scene: &Scene<O, L>,
-    settings: &PhotonSettings,
-    seed: u64,
-    pass: u32,
-    out: &mut [Photon],
-) -> Result<ForwardStats, Error> {
-    shoot_with_splats(scene, settings, seed, pass, out, &mut ())
-}
-
-/// As [`shoot`], also keeping the camera splats (see [`Splat`]) in `splats`, emptied
-/// first. An error when `splats` is full.
+/// emission order, into `out[..stored]` (not yet balanced), and the camera splats (see
+/// [`Splat`]) into `splats`, emptied first (`&mut ()` keeps none). An error when `out`
+/// cannot hold `count × lights` photons or `splats` is full.
 pub fn shoot_with_splats<const O: usize, const L: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
@@ -514,7 +503,7 @@ impl<const N: usize> PhotonMap<N> {
         }
     }
 
-    /// Runs the forward pass into this map and balances it: see [`shoot`]. The
+    /// Runs the forward pass into this map and balances it: see [`shoot_with_splats`]. The
     /// camera's splats are dropped: see [`build_with_splats`](Self::build_with_splats).
     pub fn build<const O: usize, const L: usize>(
         &mut self,
