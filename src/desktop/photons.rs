@@ -10,6 +10,7 @@ use std::vec;
 use super::progress::Progress;
 use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
+use crate::error::within;
 use crate::photon::{
     self, balance, photons_needed, Emitter, KdTree, Landed, Photon, PhotonSettings, Splat,
 };
@@ -33,14 +34,7 @@ pub(super) fn desktop_budget<const O: usize, const L: usize>(
     settings: &PhotonSettings,
 ) -> Result<usize, Error> {
     let needed = photons_needed(scene, settings);
-    if needed > MAX_PHOTONS {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: MAX_PHOTONS,
-        });
-    }
-    Ok(needed)
+    within(needed, MAX_PHOTONS, "photons (count × lights)")
 }
 
 /// Balances the kd-tree on `threads` threads: the top levels on this one, then the
@@ -128,13 +122,7 @@ impl PhotonBuffer {
         progress: &Progress,
     ) -> Result<(), Error> {
         let needed = photons_needed(scene, settings);
-        if needed > self.photons.len() {
-            return Err(Error::Capacity {
-                what: "photons (count × lights)",
-                requested: needed,
-                capacity: self.photons.len(),
-            });
-        }
+        within(needed, self.photons.len(), "photons (count × lights)")?;
         let t = Instant::now();
         let emitter = Emitter::new(scene, settings, seed, pass);
         let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())

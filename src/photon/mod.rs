@@ -31,7 +31,7 @@ pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;
 
-use crate::error::{in_range, positive, Error};
+use crate::error::{in_range, positive, within, Error};
 use crate::geometry::Ray;
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
@@ -458,14 +458,11 @@ pub fn shoot_with_splats<const O: usize, const L: usize>(
     out: &mut [Photon],
     splats: &mut impl SplatStorage,
 ) -> Result<ForwardStats, Error> {
-    let needed = photons_needed(scene, settings);
-    if needed > out.len() {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: out.len(),
-        });
-    }
+    within(
+        photons_needed(scene, settings),
+        out.len(),
+        "photons (count × lights)",
+    )?;
     splats.clear_splats();
     let mut n = 0;
     forward(scene, settings, seed, pass, |x| {
