@@ -13,7 +13,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
-use super::settings::{Gather, Given, Key, SettingsInput, StoreKind};
+use super::settings::{Gather, Given, Key, PhotonInput, SettingsInput, StoreKind};
 use super::{DesktopScene, MAX_LIGHTS, MAX_OBJECTS};
 use crate::camera::Camera;
 use crate::geometry::Shape;
@@ -464,13 +464,15 @@ fn settings_input(image: Option<&ImageDef>, p: PhotonsDef) -> Result<SettingsInp
     Ok(SettingsInput {
         width: image.map(|i| Given::file(i.width)),
         height: image.map(|i| Given::file(i.height)),
-        count: p.count.map(Given::file),
-        k: p.k.map(Given::file),
-        max_radius: p.max_radius.map(Given::file),
-        max_depth: p.max_depth.map(Given::file),
+        photons: PhotonInput {
+            count: p.count.map(Given::file),
+            k: p.k.map(Given::file),
+            max_radius: p.max_radius.map(Given::file),
+            max_depth: p.max_depth.map(Given::file),
+            gather: gather.map(Given::file),
+        },
         passes: p.passes.map(Given::file),
         alpha: p.alpha.map(Given::file),
-        gather: gather.map(Given::file),
         store: store.map(Given::file),
         texel_size: texel_size.map(Given::file),
         max_rays: image.and_then(|i| i.max_rays_per_sample).map(Given::file),
