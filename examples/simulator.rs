@@ -206,21 +206,23 @@ where
     D::Color: From<Rgb888>,
     D::Error: std::fmt::Debug,
 {
-    let tone = ToneMap::default();
+    let (tone, dither) = (ToneMap::default(), opts.dither);
+    let mut sink = |y: u32, pixels: &[Rgb]| -> Result<(), Box<dyn Error>> {
+        DisplaySink::new(&mut *display, tone, dither)
+            .draw_row(y, pixels)
+            .map_err(|e| format!("display error at row {y}: {e:?}"))?;
+        after_row(y, display);
+        Ok(())
+    };
+    let seed = opts.budget.seed;
     match &opts.scene {
         None => {
             let scene = demo::fig6::<DEVICE_OBJECTS, DEVICE_LIGHTS>(opts.width, opts.height)?;
             let device = SettingsInput::of(&budget::FIG6.settings()?);
             let input = device.overridden_by(&opts.budget.input());
             let settings = opts.budget.finish(input.validate(&scene)?.photons);
-            draw::<_, DEVICE_OBJECTS, DEVICE_LIGHTS, DEVICE_GATHER, DEVICE_DEPTH>(
-                &scene,
-                &settings,
-                opts.budget.seed,
-                tone,
-                opts.dither,
-                display,
-                after_row,
+            draw::<DEVICE_OBJECTS, DEVICE_LIGHTS, DEVICE_GATHER, DEVICE_DEPTH>(
+                &scene, &settings, seed, &mut sink,
             )
         }
         Some(path) => {
@@ -238,36 +240,26 @@ where
                 );
             }
             let settings = opts.budget.finish(loaded.photons);
-            draw::<_, MAX_OBJECTS, MAX_LIGHTS, MAX_GATHER, MAX_DEPTH>(
+            draw::<MAX_OBJECTS, MAX_LIGHTS, MAX_GATHER, MAX_DEPTH>(
                 &loaded.scene,
                 &settings,
-                opts.budget.seed,
-                tone,
-                opts.dither,
-                display,
-                after_row,
+                seed,
+                &mut sink,
             )
         }
     }
 }
 
 /// The device's pipeline with the photon array on the heap (any `--photons`): the
-/// same forward pass ([`photon::shoot`], pass 0, then [`photon::balance`]) as
-/// `PhotonMap::build`, a gather of `K`, a path stack of `DEPTH`, one row buffer.
-fn draw<D, const O: usize, const L: usize, const K: usize, const DEPTH: usize>(
+/// same forward pass ([`photon::shoot_with_splats`], pass 0, then [`photon::balance`]) as
+/// `PhotonMap::build`, a gather of `K`, a path stack of `DEPTH`, one row buffer whose
+/// rows go to `sink(y, pixels)`.
+fn draw<const O: usize, const L: usize, const K: usize, const DEPTH: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
     seed: u64,
-    tone: ToneMap,
-    dither: Dither,
-    display: &mut D,
-    after_row: &mut dyn FnMut(u32, &D),
-) -> Result<Stats, Box<dyn Error>>
-where
-    D: DrawTarget,
-    D::Color: From<Rgb888>,
-    D::Error: std::fmt::Debug,
-{
+    mut sink: impl FnMut(u32, &[Rgb]) -> Result<(), Box<dyn Error>>,
+) -> Result<Stats, Box<dyn Error>> {
     let needed = photon::photons_needed(scene, settings);
     if needed > desktop::MAX_PHOTONS {
         return Err(format!(
@@ -298,13 +290,7 @@ where
 
     let mut row = vec![Rgb::ZERO; scene.camera().width() as usize];
     let count = renderer
-        .rows(&mut row, |y, pixels| {
-            DisplaySink::new(&mut *display, tone, dither)
-                .draw_row(y, pixels)
-                .map_err(|e| format!("display error at row {y}: {e:?}"))?;
-            after_row(y, display);
-            Ok::<_, Box<dyn Error>>(())
-        })
+        .rows(&mut row, |y, pixels| sink(y, pixels))
         .map_err(|e| e.to_string())?;
     Ok(Stats {
         emitted: forward.emitted,

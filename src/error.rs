@@ -114,6 +114,24 @@ pub(crate) fn positive(x: f32, what: &'static str) -> Result<f32, Error> {
     }
 }
 
+/// `Ok(requested)` when `requested` items fit into `capacity`, else
+/// [`Error::Capacity`] naming `what`.
+pub(crate) fn within(
+    requested: usize,
+    capacity: usize,
+    what: &'static str,
+) -> Result<usize, Error> {
+    if requested <= capacity {
+        Ok(requested)
+    } else {
+        Err(Error::Capacity {
+            what,
+            requested,
+            capacity,
+        })
+    }
+}
+
 /// `Ok(x)` when `x` is finite and in `[min, max]`.
 pub(crate) fn in_range(x: f32, min: f32, max: f32, what: &'static str) -> Result<f32, Error> {
     if finite(x, what)? >= min && x <= max {

@@ -358,49 +358,30 @@ impl Rgb {
     }
 }
 
-impl Add for Rgb {
-    type Output = Rgb;
-    #[inline]
-    fn add(self, o: Rgb) -> Rgb {
-        Rgb::new(self.r + o.r, self.g + o.g, self.b + o.b)
-    }
+/// `Rgb ∘ Rgb` channel by channel and its assigning form `∘=`, for `+`, `−` and `×`.
+macro_rules! channelwise {
+    ($($Op:ident::$op:ident, $OpAssign:ident::$op_assign:ident, $sym:tt;)*) => {$(
+        impl $Op for Rgb {
+            type Output = Rgb;
+            #[inline]
+            fn $op(self, o: Rgb) -> Rgb {
+                Rgb::new(self.r $sym o.r, self.g $sym o.g, self.b $sym o.b)
+            }
+        }
+
+        impl $OpAssign for Rgb {
+            #[inline]
+            fn $op_assign(&mut self, o: Rgb) {
+                *self = *self $sym o;
+            }
+        }
+    )*};
 }
 
-impl AddAssign for Rgb {
-    #[inline]
-    fn add_assign(&mut self, o: Rgb) {
-        *self = *self + o;
-    }
-}
-
-impl Sub for Rgb {
-    type Output = Rgb;
-    #[inline]
-    fn sub(self, o: Rgb) -> Rgb {
-        Rgb::new(self.r - o.r, self.g - o.g, self.b - o.b)
-    }
-}
-
-impl SubAssign for Rgb {
-    #[inline]
-    fn sub_assign(&mut self, o: Rgb) {
-        *self = *self - o;
-    }
-}
-
-impl Mul for Rgb {
-    type Output = Rgb;
-    #[inline]
-    fn mul(self, o: Rgb) -> Rgb {
-        Rgb::new(self.r * o.r, self.g * o.g, self.b * o.b)
-    }
-}
-
-impl MulAssign for Rgb {
-    #[inline]
-    fn mul_assign(&mut self, o: Rgb) {
-        *self = *self * o;
-    }
+channelwise! {
+    Add::add, AddAssign::add_assign, +;
+    Sub::sub, SubAssign::sub_assign, -;
+    Mul::mul, MulAssign::mul_assign, *;
 }
 
 impl Mul<f32> for Rgb {

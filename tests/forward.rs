@@ -8,7 +8,6 @@ use std::f64::consts::PI;
 use caustic::camera::Camera;
 use caustic::desktop::{parse_scene, DesktopScene, Image};
 use caustic::geometry::Shape;
-use caustic::light::PointLight;
 use caustic::material::{interface, Material};
 use caustic::math::{Rgb, UnitVec3, Vec3};
 use caustic::photon::{
@@ -16,7 +15,7 @@ use caustic::photon::{
 };
 use caustic::render::Renderer;
 use caustic::scene::Scene;
-use support::scene_text;
+use support::{add_floor, add_light, scene_text, worst_floor_irradiance_error};
 
 /// Shoots, balances and returns the photons and their power unit.
 fn photons<const O: usize, const L: usize>(
@@ -25,7 +24,7 @@ fn photons<const O: usize, const L: usize>(
     seed: u64,
 ) -> (Vec<Photon>, f32, u64) {
     let mut buf = vec![Photon::ZERO; photon::photons_needed(scene, s)];
-    let f = photon::shoot(scene, s, seed, 0, &mut buf).unwrap();
+    let f = photon::shoot_with_splats(scene, s, seed, 0, &mut buf, &mut ()).unwrap();
     buf.truncate(f.stored);
     balance(&mut buf);
     (buf, f.power_unit, f.emitted)
@@ -42,15 +41,8 @@ fn density_estimate_reproduces_analytic_irradiance() {
     let light = Vec3::new(0.0, 2.0, 0.0);
     let intensity = 7.0f32;
     let mut scene: Scene<1, 1> = Scene::new(camera());
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(light, Rgb::splat(intensity)).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
+    add_light(&mut scene, light, Rgb::splat(intensity));
     let settings = PhotonSettings::new(400_000, 400, 0.5, 4)
         .unwrap()
         .with_direct_photons(true);
@@ -61,18 +53,11 @@ fn density_estimate_reproduces_analytic_irradiance() {
         map.len()
     );
     let store = store_over::<512>(KdTree::from_balanced(&map), unit, &settings).unwrap();
-    let mut worst = 0.0f64;
-    for i in 0..40 {
-        let a = i as f32 * 0.61;
-        let r = 0.05 * i as f32;
-        let x = Vec3::new(r * a.cos(), 0.0, r * a.sin());
-        let e = store.irradiance(x, UnitVec3::Y).r as f64;
-        let to = (light - x).as_dvec3();
-        let want = intensity as f64 * (to.y / to.length()) / to.length_squared();
-        worst = worst.max((e - want).abs() / want);
+    let worst = worst_floor_irradiance_error(light, intensity, 0.05, |x| {
         // Photons arrive from above: seen from below the floor, nothing.
         assert_eq!(store.irradiance(x, -UnitVec3::Y), Rgb::ZERO);
-    }
+        store.irradiance(x, UnitVec3::Y).r as f64
+    });
     eprintln!(
         "density: worst relative error {:.3}% over 40 points",
         worst * 100.0
@@ -89,12 +74,7 @@ fn flux_through_a_glass_slab_matches_fresnel_transmission() {
     let (ior, half, top, light_h, intensity) = (1.5f32, 3.0f32, 1.0f32, 2.0f32, 5.0f32);
     let thickness = 0.02f32;
     let mut scene: Scene<2, 1> = Scene::new(camera());
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
     let slab = Shape::cuboid(
         Vec3::new(0.0, top - 0.5 * thickness, 0.0),
         Vec3::new(2.0 * half, thickness, 2.0 * half),
@@ -103,11 +83,11 @@ fn flux_through_a_glass_slab_matches_fresnel_transmission() {
     scene
         .add(slab.unwrap(), Material::dielectric(ior, Rgb::ZERO).unwrap())
         .unwrap();
-    scene
-        .add_light(
-            PointLight::new(Vec3::new(0.0, top + light_h, 0.0), Rgb::splat(intensity)).unwrap(),
-        )
-        .unwrap();
+    add_light(
+        &mut scene,
+        Vec3::new(0.0, top + light_h, 0.0),
+        Rgb::splat(intensity),
+    );
     let settings = PhotonSettings::new(300_000, 8, 0.1, 16).unwrap();
     let (map, unit, emitted) = photons(&scene, &settings, 5);
     assert_eq!(emitted, 300_000);
@@ -237,16 +217,14 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
             Material::diffuse(Rgb::ONE).unwrap(),
         )
         .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::Y * 3.0, Rgb::ONE).unwrap())
-        .unwrap();
+    add_light(&mut scene, Vec3::Y * 3.0, Rgb::ONE);
     let s = PhotonSettings::new(1000, 8, 0.1, 4).unwrap();
     let mut buf = vec![Photon::ZERO; 1000];
-    let f = photon::shoot(&scene, &s, 0, 0, &mut buf).unwrap();
+    let f = photon::shoot_with_splats(&scene, &s, 0, 0, &mut buf, &mut ()).unwrap();
     assert_eq!((f.emitted, f.stored), (0, 0));
     // A budget larger than the storage is an error, not a truncation.
     let mut small = vec![Photon::ZERO; 10];
-    assert!(photon::shoot(&scene, &s, 0, 0, &mut small).is_err());
+    assert!(photon::shoot_with_splats(&scene, &s, 0, 0, &mut small, &mut ()).is_err());
 }
 
 /// The desktop's parallel forward pass and balance give exactly the core's tree, on any
@@ -254,6 +232,7 @@ fn a_scene_without_caustic_objects_shoots_nothing() {
 #[test]
 fn the_parallel_forward_pass_is_the_serial_one() {
     use caustic::desktop::photons::PhotonBuffer;
+    use caustic::desktop::progress::Progress;
     use caustic::desktop::RenderStats;
     let text = scene_text("two_balls.json");
     let scene = parse_scene(&text).unwrap().scene;
@@ -263,8 +242,16 @@ fn the_parallel_forward_pass_is_the_serial_one() {
     assert!(serial.len() > 1 << 15, "{}", serial.len());
     for threads in [1, 3] {
         let mut buf = PhotonBuffer::for_budget(&scene, &s).unwrap();
-        buf.fill(&scene, &s, 9, 0, threads, &mut RenderStats::default())
-            .unwrap();
+        buf.fill(
+            &scene,
+            &s,
+            9,
+            0,
+            threads,
+            &mut RenderStats::default(),
+            &Progress::hidden(),
+        )
+        .unwrap();
         assert_eq!(buf.unit(), unit);
         assert_eq!(buf.tree().photons(), &serial[..], "{threads} threads");
     }

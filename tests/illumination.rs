@@ -1,6 +1,6 @@
 //! Illumination maps (Arvo; paper section 3.1) against analytic answers: flat maps
 //! from uniform flux, energy conservation, true texel areas, the single-photon round
-//! trip, determinism, and the streaming forward pass against `shoot`.
+//! trip, determinism, and the streaming forward pass against `shoot_with_splats`.
 
 mod support;
 
@@ -17,7 +17,7 @@ use caustic::photon::{
     PhotonSettings,
 };
 use caustic::scene::Scene;
-use support::{data_text, scene_text};
+use support::{add_light, data_text, scene_text, worst_floor_irradiance_error};
 
 type Maps = IlluminationMaps<Vec<Rgb>, 8>;
 
@@ -101,9 +101,7 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
     scene
         .add(Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(), diffuse())
         .unwrap();
-    scene
-        .add_light(PointLight::new(light, Rgb::splat(intensity)).unwrap())
-        .unwrap();
+    add_light(&mut scene, light, Rgb::splat(intensity));
     let settings = PhotonSettings::new(400_000, 64, 0.5, 4)
         .unwrap()
         .with_direct_photons(true);
@@ -116,16 +114,9 @@ fn direct_photons_reproduce_the_analytic_irradiance() {
     let (forward, stats) = maps.build(&scene, &settings, 11).unwrap();
     assert!(forward.stored > 190_000);
     eprintln!("direct: {:?}", stats);
-    let mut worst = 0.0f64;
-    for i in 0..40 {
-        let a = i as f32 * 0.61;
-        let r = 0.02 * i as f32;
-        let x = Vec3::new(r * a.cos(), 0.0, r * a.sin());
-        let e = maps.irradiance(x, UnitVec3::Y).r as f64;
-        let to = (light - x).as_dvec3();
-        let want = intensity as f64 * (to.y / to.length()) / to.length_squared();
-        worst = worst.max((e - want).abs() / want);
-    }
+    let worst = worst_floor_irradiance_error(light, intensity, 0.02, |x| {
+        maps.irradiance(x, UnitVec3::Y).r as f64
+    });
     eprintln!("direct: worst relative error {:.3}%", worst * 100.0);
     assert!(worst < 0.03, "worst {worst}");
 }
@@ -300,7 +291,7 @@ fn single_photon_round_trip_conserves_energy() {
 }
 
 /// The same seed gives the same bits; the streaming forward pass hands out exactly
-/// the photons `shoot` stores, so maps built either way are identical; and a fixed
+/// the photons `shoot_with_splats` stores, so maps built either way are identical; and a fixed
 /// array holds the same maps as a `Vec`.
 #[test]
 fn same_seed_same_bits_and_streaming_equals_stored() {
@@ -309,7 +300,7 @@ fn same_seed_same_bits_and_streaming_equals_stored() {
     let scene = &loaded.scene;
     let settings = PhotonSettings::new(5_000, 32, 0.1, 8).unwrap();
     let mut shot = vec![Photon::ZERO; photon::photons_needed(scene, &settings)];
-    let f = photon::shoot(scene, &settings, 9, 0, &mut shot).unwrap();
+    let f = photon::shoot_with_splats(scene, &settings, 9, 0, &mut shot, &mut ()).unwrap();
     shot.truncate(f.stored);
     let mut streamed = Vec::new();
     let g = for_each_photon(scene, &settings, 9, 0, |p| streamed.push(*p));
@@ -432,6 +423,7 @@ fn a_layout_beyond_the_texel_budget_is_coarsened_to_fit() {
 #[test]
 fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     use caustic::desktop::photons::PhotonBuffer;
+    use caustic::desktop::progress::Progress;
     use caustic::desktop::{RenderStats, MAX_GATHER, MAX_OBJECTS};
     use caustic::photon::DEFAULT_HEAP_TEXELS;
 
@@ -496,7 +488,15 @@ fn a_back_wall_fits_the_budget_and_keeps_the_caustic_energy() {
     };
     let mut photons = PhotonBuffer::for_budget(scene, settings).unwrap();
     photons
-        .fill(scene, settings, 7, 0, 2, &mut RenderStats::default())
+        .fill(
+            scene,
+            settings,
+            7,
+            0,
+            2,
+            &mut RenderStats::default(),
+            &Progress::hidden(),
+        )
         .unwrap();
     let kd = photon::store_over::<MAX_GATHER>(photons.tree(), photons.unit(), settings).unwrap();
     let (e_maps, e_kd) = (integral(&maps), integral(&kd));

@@ -11,7 +11,6 @@ use caustic::desktop::run::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
 use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Ray, Shape};
-use caustic::light::PointLight;
 use caustic::material::Classic;
 use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
@@ -20,32 +19,17 @@ use caustic::photon::{NoCaustics, PhotonSettings};
 use caustic::render::PixelEstimate;
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
-use support::scene_text;
+use support::{add_floor, add_glass_sphere, add_light, scene_text};
 
 /// A diffuse floor of albedo ρ under a point light: every pixel that sees the floor has
 /// radiance ρ·I·cosθ/(π·d²), evaluated here in f64 from the analytic ray–plane hit.
 #[test]
 fn direct_light_on_a_diffuse_floor_is_analytic() {
     let (albedo, intensity, light) = (0.63f32, Rgb::new(10.0, 5.0, 2.5), Vec3::new(0.4, 2.5, -0.3));
-    let camera = Camera::new(
-        Vec3::new(0.0, 3.0, 4.0),
-        Vec3::new(0.0, 0.0, -1.0),
-        Vec3::Y,
-        50.0,
-        48,
-        36,
-    )
-    .unwrap();
+    let camera = Camera::new(Vec3::new(0.0, 3.0, 4.0), Vec3::NEG_Z, Vec3::Y, 50.0, 48, 36).unwrap();
     let mut scene: Scene<1, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::splat(albedo)).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(light, intensity).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::splat(albedo));
+    add_light(&mut scene, light, intensity);
     let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     let mut worst = 0.0f64;
     let mut seen = 0;
@@ -76,12 +60,7 @@ fn direct_light_on_a_diffuse_floor_is_analytic() {
 /// A ray through a parallel glass slab leaves parallel to how it came in, displaced.
 #[test]
 fn refraction_through_a_slab_exits_parallel() {
-    let slab = Shape::cuboid(
-        Vec3::ZERO,
-        Vec3::new(100.0, 0.5, 100.0),
-        Vec3::new(0.0, 0.0, 0.0),
-    )
-    .unwrap();
+    let slab = Shape::cuboid(Vec3::ZERO, Vec3::new(100.0, 0.5, 100.0), Vec3::ZERO).unwrap();
     for (i, angle) in [0.0f32, 0.2, 0.5, 0.9, 1.3].into_iter().enumerate() {
         let d = UnitVec3::new(Vec3::new(angle.sin(), -angle.cos(), 0.1 * i as f32)).unwrap();
         let ray = Ray::new(Vec3::new(0.0, 2.0, 0.0), d);
@@ -117,21 +96,9 @@ fn refraction_through_a_slab_exits_parallel() {
 fn glass_casts_a_shadow_for_direct_light() {
     let camera = Camera::new(Vec3::new(0.0, 5.0, 0.001), Vec3::ZERO, Vec3::Y, 10.0, 9, 9).unwrap();
     let mut scene: Scene<2, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add(
-            Shape::sphere(Vec3::new(5.0, 2.0, 0.0), 0.5).unwrap(),
-            Material::dielectric(1.5, Rgb::ZERO).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(10.0, 4.0, 0.0), Rgb::ONE).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
+    add_glass_sphere(&mut scene, Vec3::new(5.0, 2.0, 0.0), 0.5);
+    add_light(&mut scene, Vec3::new(10.0, 4.0, 0.0), Rgb::ONE);
     let r: Renderer<_, 2, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     // The floor point (0,0,0) lies exactly behind the sphere as seen from the light.
     let down = Ray::new(Vec3::new(0.0, 1.0, 0.0), -UnitVec3::Y);
@@ -183,7 +150,7 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
     let mut stats = caustic::desktop::RenderStats::default();
     let mut photons = PhotonBuffer::for_budget(&scene, &settings).unwrap();
     photons
-        .fill(&scene, &settings, 1, 0, 2, &mut stats)
+        .fill(&scene, &settings, 1, 0, 2, &mut stats, &Progress::hidden())
         .unwrap();
     let store = photon::store_over::<128>(photons.tree(), photons.unit(), &settings).unwrap();
     let image = |cutoff: f32, budget: u32| {
@@ -220,15 +187,7 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
 /// most of it; with the default cut-off too.
 #[test]
 fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
-    let camera = Camera::new(
-        Vec3::new(0.0, 0.0, 0.5),
-        Vec3::new(0.0, 0.0, -1.0),
-        Vec3::Y,
-        60.0,
-        16,
-        12,
-    )
-    .unwrap();
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 0.5), Vec3::NEG_Z, Vec3::Y, 60.0, 16, 12).unwrap();
     let mut scene: Scene<8, 2> = Scene::new(camera);
     let glassy = Material::classic(Classic::new(
         Rgb::splat(0.9),
@@ -259,12 +218,8 @@ fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
             walls,
         )
         .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(0.5, 1.0, 0.0), Rgb::splat(5.0)).unwrap())
-        .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(-1.0, -1.0, -1.0), Rgb::splat(2.0)).unwrap())
-        .unwrap();
+    add_light(&mut scene, Vec3::new(0.5, 1.0, 0.0), Rgb::splat(5.0));
+    add_light(&mut scene, Vec3::new(-1.0, -1.0, -1.0), Rgb::splat(2.0));
     for (cutoff, budget) in [
         (0.0, 300),
         (0.0, DEFAULT_RAY_BUDGET),
@@ -310,12 +265,7 @@ fn a_deep_classic_scene_spends_at_most_the_ray_budget_per_pixel() {
 fn rows_refuses_a_short_row_buffer() {
     let camera = Camera::new(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0, 8, 2).unwrap();
     let mut scene: Scene<1, 1> = Scene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::ONE).unwrap(),
-        )
-        .unwrap();
+    add_floor(&mut scene, Rgb::ONE);
     let r: Renderer<_, 1, 1, 4> = Renderer::new(&scene, &NoCaustics, 4).unwrap();
     let mut short = [Rgb::ZERO; 7];
     let mut called = false;
@@ -718,6 +668,18 @@ fn the_program_reports_bad_input_with_exit_status_2() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// Runs `command`, asserts that it succeeded (else shows its stderr) and parses its
+/// stdout as JSON.
+fn json_stdout(command: &mut std::process::Command) -> serde_json::Value {
+    let out = command.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 /// The program renders what the library renders: its PFM holds the library's bits, its
 /// `--stats` the sizes and counts, and `compare` measures a known difference.
 #[test]
@@ -727,31 +689,25 @@ fn the_program_writes_the_library_image_and_compares_it() {
     let exe = env!("CARGO_BIN_EXE_caustic");
     let scene = format!("{}/scenes/glass_sphere.json", env!("CARGO_MANIFEST_DIR"));
     let (png, pfm) = (dir.join("g.png"), dir.join("g.pfm"));
-    let out = std::process::Command::new(exe)
-        .args([
-            "render",
-            &scene,
-            "--width",
-            "40",
-            "--height",
-            "30",
-            "--photons",
-            "5000",
-            "--stats",
-            "--quiet",
-            "-o",
-        ])
-        .arg(&png)
-        .arg("--pfm")
-        .arg(&pfm)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let stats = json_stdout(
+        std::process::Command::new(exe)
+            .args([
+                "render",
+                &scene,
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "--photons",
+                "5000",
+                "--stats",
+                "--quiet",
+                "-o",
+            ])
+            .arg(&png)
+            .arg("--pfm")
+            .arg(&pfm),
     );
-    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(
         (stats["width"].as_u64(), stats["height"].as_u64()),
         (Some(40), Some(30))
@@ -784,18 +740,12 @@ fn the_program_writes_the_library_image_and_compares_it() {
     }
     let scaled_path = dir.join("scaled.pfm");
     scaled.write_pfm(&scaled_path).unwrap();
-    let cmp = std::process::Command::new(exe)
-        .args(["compare"])
-        .arg(&scaled_path)
-        .arg(&pfm)
-        .output()
-        .unwrap();
-    assert!(
-        cmp.status.success(),
-        "{}",
-        String::from_utf8_lossy(&cmp.stderr)
+    let c = json_stdout(
+        std::process::Command::new(exe)
+            .args(["compare"])
+            .arg(&scaled_path)
+            .arg(&pfm),
     );
-    let c: serde_json::Value = serde_json::from_slice(&cmp.stdout).unwrap();
     let values: Vec<f64> = img
         .pixels
         .iter()

@@ -24,7 +24,7 @@ use caustic::render::PixelEstimate;
 use caustic::render::{Renderer, DEFAULT_RAY_BUDGET};
 use proptest::prelude::*;
 use serde_json::Value;
-use support::{scene_text, Rng};
+use support::{add_floor, add_glass_sphere, add_light, scene_text, Rng};
 
 // ---------------------------------------------------------------------------------
 // Shapes: an independent f64 oracle for each.
@@ -777,9 +777,7 @@ fn random_scene(seed: u64) -> Option<(DesktopScene, PhotonSettings)> {
         } else {
             rng.rgb(100.0) * (s * s)
         };
-        scene
-            .add_light(PointLight::new(p, intensity).unwrap())
-            .unwrap();
+        add_light(&mut scene, p, intensity);
     }
     let settings = PhotonSettings::new(
         50 + rng.below(250) as u32,
@@ -826,7 +824,7 @@ fn check_random_scene(seed: u64) -> Option<usize> {
         );
     }
     let mut photons = vec![Photon::ZERO; photon::photons_needed(&scene, &settings)];
-    let f = photon::shoot(&scene, &settings, seed, 0, &mut photons).unwrap();
+    let f = photon::shoot_with_splats(&scene, &settings, seed, 0, &mut photons, &mut ()).unwrap();
     let stored = photons[..f.stored]
         .iter()
         .fold(Rgb::ZERO, |a, p| a + p.power() * f.power_unit);
@@ -1055,24 +1053,12 @@ fn all_photons_at_one_point_queried_nearby() {
 fn a_zero_power_light() {
     let camera = Camera::new(Vec3::new(0.0, 3.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0, 16, 12).unwrap();
     let mut scene = DesktopScene::new(camera);
-    scene
-        .add(
-            Shape::plane(Vec3::ZERO, Vec3::Y).unwrap(),
-            Material::diffuse(Rgb::splat(0.8)).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add(
-            Shape::sphere(Vec3::new(0.0, 1.0, 0.0), 1.0).unwrap(),
-            Material::dielectric(1.5, Rgb::ZERO).unwrap(),
-        )
-        .unwrap();
-    scene
-        .add_light(PointLight::new(Vec3::new(0.0, 5.0, 0.0), Rgb::ZERO).unwrap())
-        .unwrap();
+    add_floor(&mut scene, Rgb::splat(0.8));
+    add_glass_sphere(&mut scene, Vec3::new(0.0, 1.0, 0.0), 1.0);
+    add_light(&mut scene, Vec3::new(0.0, 5.0, 0.0), Rgb::ZERO);
     let settings = PhotonSettings::new(1000, 16, 0.1, 8).unwrap();
     let mut photons = vec![Photon::ZERO; photon::photons_needed(&scene, &settings)];
-    let f = photon::shoot(&scene, &settings, 0, 0, &mut photons).unwrap();
+    let f = photon::shoot_with_splats(&scene, &settings, 0, 0, &mut photons, &mut ()).unwrap();
     assert_eq!(f.stored, 0);
     let (image, _) = render(
         &scene,
@@ -1093,7 +1079,15 @@ fn a_zero_power_light() {
         ..RenderOptions::default()
     };
     scene.add_light(bright).unwrap();
-    let f = photon::shoot(&scene, &settings, 0, 0, &mut vec![Photon::ZERO; 2000]).unwrap();
+    let f = photon::shoot_with_splats(
+        &scene,
+        &settings,
+        0,
+        0,
+        &mut vec![Photon::ZERO; 2000],
+        &mut (),
+    )
+    .unwrap();
     assert!(f.stored > 0 && f.power_unit.is_finite());
     assert_eq!(f.emitted, settings.count() as u64);
     let (image, stats) = render(&scene, &settings, &opts).unwrap();
@@ -1104,9 +1098,7 @@ fn a_zero_power_light() {
         moved.add(o.shape, o.material).unwrap();
     }
     // The dark light inside the glass sphere now.
-    moved
-        .add_light(PointLight::new(Vec3::new(0.0, 1.0, 0.0), Rgb::ZERO).unwrap())
-        .unwrap();
+    add_light(&mut moved, Vec3::new(0.0, 1.0, 0.0), Rgb::ZERO);
     moved.add_light(bright).unwrap();
     let (image2, stats2) = render(&moved, &settings, &opts).unwrap();
     assert!(image.pixels == image2.pixels && stats.rays == stats2.rays);

@@ -17,7 +17,7 @@ use clap::{Args, ValueEnum};
 
 use super::image::ExrPrecision;
 use super::run::{available_threads, RenderOptions};
-use super::settings::{Gather, Given, SettingsInput, StoreKind};
+use super::settings::{Gather, Given, PhotonInput, SettingsInput, StoreKind};
 use super::LoadedScene;
 use crate::photon::{ConeFilter, PhotonSettings};
 use crate::render::{Sampling, REFINE};
@@ -107,11 +107,13 @@ impl PhotonArgs {
     /// The values given as flags, for [`SettingsInput::overridden_by`].
     pub fn input(&self) -> SettingsInput {
         SettingsInput {
-            count: self.count.map(Given::flag),
-            k: self.k.map(Given::flag),
-            max_radius: self.radius.map(Given::flag),
-            max_depth: self.max_depth.map(Given::flag),
-            gather: self.gather.map(Given::flag),
+            photons: PhotonInput {
+                count: self.count.map(Given::flag),
+                k: self.k.map(Given::flag),
+                max_radius: self.radius.map(Given::flag),
+                max_depth: self.max_depth.map(Given::flag),
+                gather: self.gather.map(Given::flag),
+            },
             ..SettingsInput::default()
         }
     }

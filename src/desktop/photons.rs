@@ -10,6 +10,7 @@ use std::vec;
 use super::progress::Progress;
 use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
+use crate::error::within;
 use crate::photon::{
     self, balance, photons_needed, Emitter, KdStore, KdTree, Landed, Photon, PhotonSettings, Splat,
     THINNING,
@@ -36,14 +37,7 @@ pub(super) fn desktop_budget<const O: usize, const L: usize>(
     settings: &PhotonSettings,
 ) -> Result<usize, Error> {
     let needed = photons_needed(scene, settings);
-    if needed > MAX_PHOTONS {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: MAX_PHOTONS,
-        });
-    }
-    Ok(needed)
+    within(needed, MAX_PHOTONS, "photons (count × lights)")
 }
 
 /// Balances the kd-tree on `threads` threads: the top levels on this one, then the
@@ -116,25 +110,12 @@ impl PhotonBuffer {
     }
 
     /// Runs forward pass `pass` into the buffer on `threads` threads and balances it,
-    /// adding the times and counts to `stats`. The photons are traced in chunks of
-    /// `CHUNK` and kept in emission order: the same array as the core's
-    /// [`photon::shoot`], whatever the thread count.
-    pub fn fill<const O: usize, const L: usize>(
-        &mut self,
-        scene: &Scene<O, L>,
-        settings: &PhotonSettings,
-        seed: u64,
-        pass: u32,
-        threads: usize,
-        stats: &mut RenderStats,
-    ) -> Result<(), Error> {
-        let hidden = Progress::new(false, 1);
-        self.fill_with_progress(scene, settings, seed, pass, threads, stats, &hidden)
-    }
-
-    /// [`PhotonBuffer::fill`], showing its two phases (photons, balance) on `progress`.
+    /// adding the times and counts to `stats` and showing its two phases (photons,
+    /// balance) on `progress` ([`Progress::hidden`] for none). The photons are traced in
+    /// chunks of `CHUNK` and kept in emission order: the same array as the core's
+    /// [`photon::shoot_with_splats`], whatever the thread count.
     #[allow(clippy::too_many_arguments)]
-    pub fn fill_with_progress<const O: usize, const L: usize>(
+    pub fn fill<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
         settings: &PhotonSettings,
@@ -145,13 +126,7 @@ impl PhotonBuffer {
         progress: &Progress,
     ) -> Result<(), Error> {
         let needed = photons_needed(scene, settings);
-        if needed > self.photons.len() {
-            return Err(Error::Capacity {
-                what: "photons (count × lights)",
-                requested: needed,
-                capacity: self.photons.len(),
-            });
-        }
+        within(needed, self.photons.len(), "photons (count × lights)")?;
         let t = Instant::now();
         let emitter = Emitter::new(scene, settings, seed, pass);
         let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())

@@ -28,6 +28,11 @@ impl Progress {
         Self { bar, passes }
     }
 
+    /// A bar that draws nothing.
+    pub fn hidden() -> Self {
+        Self::new(false, 1)
+    }
+
     /// Starts phase `name` of pass `pass` (from 0) over `steps` steps.
     pub fn phase(&self, pass: u32, name: &str, steps: usize) {
         let prefix = if self.passes > 1 {

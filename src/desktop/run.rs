@@ -336,7 +336,7 @@ pub fn render_with_error(
             libm::powf((pass + 1) as f32, 0.5 * (opts.alpha - 1.0))
         };
         let pass_settings = settings.with_max_radius(settings.max_radius() * shrink)?;
-        photons.fill_with_progress(
+        photons.fill(
             scene,
             &pass_settings,
             opts.seed,

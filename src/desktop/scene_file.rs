@@ -13,7 +13,7 @@ use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
-use super::settings::{Gather, Given, Key, SettingsInput, StoreKind};
+use super::settings::{Gather, Given, Key, PhotonInput, SettingsInput, StoreKind};
 use super::{DesktopScene, MAX_LIGHTS, MAX_OBJECTS};
 use crate::camera::Camera;
 use crate::geometry::Shape;
@@ -141,97 +141,37 @@ pub struct PhotonsDef {
     pub gather: Option<String>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PointLightDef {
-    #[serde(rename = "type")]
-    _type: String,
-    position: [f32; 3],
-    intensity: [f32; 3],
+/// The typed objects of the scene format (`{"type": …, fields}`), one line each: a
+/// struct of the fields that also takes the `type` key (its value is checked first, by
+/// [`type_of`]) and refuses any other key.
+macro_rules! typed_objects {
+    ($($name:ident { $($field:ident: $ty:ty),* $(,)? })*) => {$(
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct $name {
+            #[serde(rename = "type")]
+            _type: String,
+            $($field: $ty,)*
+        }
+    )*};
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DiffuseDef {
-    #[serde(rename = "type")]
-    _type: String,
-    albedo: [f32; 3],
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MirrorDef {
-    #[serde(rename = "type")]
-    _type: String,
-    reflectance: Option<[f32; 3]>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DielectricDef {
-    #[serde(rename = "type")]
-    _type: String,
-    ior: f32,
-    absorption: Option<[f32; 3]>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ClassicDef {
-    #[serde(rename = "type")]
-    _type: String,
-    color: [f32; 3],
-    ambient: f32,
-    diffuse: f32,
-    specular: f32,
-    shininess: f32,
-    reflectivity: f32,
-    transparency: f32,
-    ior: f32,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PlaneDef {
-    #[serde(rename = "type")]
-    _type: String,
-    point: [f32; 3],
-    normal: [f32; 3],
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SphereDef {
-    #[serde(rename = "type")]
-    _type: String,
-    center: [f32; 3],
-    radius: f32,
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct BoxDef {
-    #[serde(rename = "type")]
-    _type: String,
-    center: [f32; 3],
-    size: [f32; 3],
-    rotation_deg: Option<[f32; 3]>,
-    material: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CylinderDef {
-    #[serde(rename = "type")]
-    _type: String,
-    base: [f32; 3],
-    axis: [f32; 3],
-    radius: f32,
-    height: f32,
-    capped: Option<bool>,
-    material: String,
+typed_objects! {
+    PointLightDef { position: [f32; 3], intensity: [f32; 3] }
+    DiffuseDef { albedo: [f32; 3] }
+    MirrorDef { reflectance: Option<[f32; 3]> }
+    DielectricDef { ior: f32, absorption: Option<[f32; 3]> }
+    ClassicDef {
+        color: [f32; 3], ambient: f32, diffuse: f32, specular: f32, shininess: f32,
+        reflectivity: f32, transparency: f32, ior: f32,
+    }
+    PlaneDef { point: [f32; 3], normal: [f32; 3], material: String }
+    SphereDef { center: [f32; 3], radius: f32, material: String }
+    BoxDef { center: [f32; 3], size: [f32; 3], rotation_deg: Option<[f32; 3]>, material: String }
+    CylinderDef {
+        base: [f32; 3], axis: [f32; 3], radius: f32, height: f32, capped: Option<bool>,
+        material: String,
+    }
 }
 
 /// A scene file, read and validated.
@@ -287,6 +227,15 @@ fn type_of<'v>(v: &'v Value, path: &str, allowed: &[&str]) -> Result<&'v str, Sc
         )),
         None => Err(err(format!("{path}.type"), "missing field `type`")),
     }
+}
+
+/// The list `key` (`lights`, `objects`) holds at most `max` entries.
+fn at_most(list: &[Value], max: usize, key: &str) -> Result<(), SceneError> {
+    if list.len() > max {
+        let message = format!("{} {key}, at most {max} are supported", list.len());
+        return Err(err(key, message));
+    }
+    Ok(())
 }
 
 fn v3(a: [f32; 3]) -> Vec3 {
@@ -357,15 +306,7 @@ fn camera(c: &CameraDef, image: Option<&ImageDef>) -> Result<Camera, SceneError>
 }
 
 fn add_lights(scene: &mut DesktopScene, lights: &[Value]) -> Result<(), SceneError> {
-    if lights.len() > MAX_LIGHTS {
-        return Err(err(
-            "lights",
-            format!(
-                "{} lights, at most {MAX_LIGHTS} are supported",
-                lights.len()
-            ),
-        ));
-    }
+    at_most(lights, MAX_LIGHTS, "lights")?;
     for (i, v) in lights.iter().enumerate() {
         let path = format!("lights[{i}]");
         type_of(v, &path, &["point"])?;
@@ -484,15 +425,7 @@ fn add_objects(
     objects: &[Value],
     materials: &BTreeMap<String, Material>,
 ) -> Result<(), SceneError> {
-    if objects.len() > MAX_OBJECTS {
-        return Err(err(
-            "objects",
-            format!(
-                "{} objects, at most {MAX_OBJECTS} are supported",
-                objects.len()
-            ),
-        ));
-    }
+    at_most(objects, MAX_OBJECTS, "objects")?;
     for (i, v) in objects.iter().enumerate() {
         let path = format!("objects[{i}]");
         let (shape, material) = shape(v, &path)?;
@@ -531,13 +464,15 @@ fn settings_input(image: Option<&ImageDef>, p: PhotonsDef) -> Result<SettingsInp
     Ok(SettingsInput {
         width: image.map(|i| Given::file(i.width)),
         height: image.map(|i| Given::file(i.height)),
-        count: p.count.map(Given::file),
-        k: p.k.map(Given::file),
-        max_radius: p.max_radius.map(Given::file),
-        max_depth: p.max_depth.map(Given::file),
+        photons: PhotonInput {
+            count: p.count.map(Given::file),
+            k: p.k.map(Given::file),
+            max_radius: p.max_radius.map(Given::file),
+            max_depth: p.max_depth.map(Given::file),
+            gather: gather.map(Given::file),
+        },
         passes: p.passes.map(Given::file),
         alpha: p.alpha.map(Given::file),
-        gather: gather.map(Given::file),
         store: store.map(Given::file),
         texel_size: texel_size.map(Given::file),
         max_rays: image.and_then(|i| i.max_rays_per_sample).map(Given::file),

@@ -210,6 +210,24 @@ pub struct SettingsInput {
     pub width: Option<Given<u32>>,
     /// Image height in pixels.
     pub height: Option<Given<u32>>,
+    /// The photon budget and estimate.
+    pub photons: PhotonInput,
+    /// Progressive passes.
+    pub passes: Option<Given<u32>>,
+    /// Radius shrink exponent of the passes.
+    pub alpha: Option<Given<f32>>,
+    /// The caustic store.
+    pub store: Option<Given<StoreKind>>,
+    /// The illumination maps' texel side.
+    pub texel_size: Option<Given<f32>>,
+    /// The cap on rays per camera ray.
+    pub max_rays: Option<Given<u32>>,
+}
+
+/// The settings of [`PhotonSettings::new`] and its gather before validation: each value
+/// if given, and where.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonInput {
     /// Photons emitted per light.
     pub count: Option<Given<u32>>,
     /// Photons per estimate.
@@ -218,18 +236,8 @@ pub struct SettingsInput {
     pub max_radius: Option<Given<f32>>,
     /// Specular interactions per path.
     pub max_depth: Option<Given<u32>>,
-    /// Progressive passes.
-    pub passes: Option<Given<u32>>,
-    /// Radius shrink exponent of the passes.
-    pub alpha: Option<Given<f32>>,
     /// How the kd-tree estimate gathers.
     pub gather: Option<Given<Gather>>,
-    /// The caustic store.
-    pub store: Option<Given<StoreKind>>,
-    /// The illumination maps' texel side.
-    pub texel_size: Option<Given<f32>>,
-    /// The cap on rays per camera ray.
-    pub max_rays: Option<Given<u32>>,
 }
 
 /// The shared settings, validated.
@@ -252,17 +260,8 @@ pub struct Settings {
 impl SettingsInput {
     /// The values of `settings` as if a file had given them (a program's built-in scene).
     pub fn of(settings: &PhotonSettings) -> Self {
-        let gather = if settings.fixed_radius() {
-            Gather::Radius
-        } else {
-            Gather::Nearest
-        };
         Self {
-            count: Some(Given::file(settings.count())),
-            k: Some(Given::file(settings.k())),
-            max_radius: Some(Given::file(settings.max_radius())),
-            max_depth: Some(Given::file(settings.max_depth())),
-            gather: Some(Given::file(gather)),
+            photons: PhotonInput::of(settings),
             ..Self::default()
         }
     }
@@ -272,13 +271,9 @@ impl SettingsInput {
         Self {
             width: over.width.or(self.width),
             height: over.height.or(self.height),
-            count: over.count.or(self.count),
-            k: over.k.or(self.k),
-            max_radius: over.max_radius.or(self.max_radius),
-            max_depth: over.max_depth.or(self.max_depth),
+            photons: self.photons.overridden_by(&over.photons),
             passes: over.passes.or(self.passes),
             alpha: over.alpha.or(self.alpha),
-            gather: over.gather.or(self.gather),
             store: over.store.or(self.store),
             texel_size: over.texel_size.or(self.texel_size),
             max_rays: over.max_rays.or(self.max_rays),
@@ -295,7 +290,7 @@ impl SettingsInput {
     ) -> Result<Settings, SceneError> {
         Ok(Settings {
             camera: self.camera(scene.camera())?,
-            photons: self.photons(|| default_radius(scene))?,
+            photons: self.photons.validate(|| default_radius(scene))?,
             passes: self.passes()?,
             alpha: self.alpha()?,
             caustic_store: self.store()?,
@@ -319,48 +314,6 @@ impl SettingsInput {
             };
             key_err(key, given.map_or(Source::File, |g| g.source), problem(&e))
         })
-    }
-
-    fn photons(&self, default_radius: impl FnOnce() -> f32) -> Result<PhotonSettings, SceneError> {
-        let value = |g: Option<Given<u32>>, default: u32| g.map_or(default, |g| g.value);
-        let source = |g: Option<Given<u32>>| g.map_or(Source::File, |g| g.source);
-        let k = value(self.k, DEFAULT_K);
-        let max_depth = value(self.max_depth, DEFAULT_MAX_DEPTH);
-        let radius = self.max_radius.map_or_else(default_radius, |g| g.value);
-        let settings = PhotonSettings::new(value(self.count, DEFAULT_COUNT), k, radius, max_depth)
-            .map_err(|e| {
-                // The core's labels of `PhotonSettings::new`, matched exactly.
-                let (key, src) = match e {
-                    Error::NotPositive {
-                        what: "photons.k", ..
-                    } => (Key::K, source(self.k)),
-                    Error::OutOfRange {
-                        what: "photons.max_depth",
-                        ..
-                    } => (Key::MaxDepth, source(self.max_depth)),
-                    _ => (
-                        Key::MaxRadius,
-                        self.max_radius.map_or(Source::File, |g| g.source),
-                    ),
-                };
-                key_err(key, src, problem(&e))
-            })?;
-        if k as usize > MAX_GATHER {
-            return Err(key_err(
-                Key::K,
-                source(self.k),
-                format!("{k} exceeds the gather capacity {MAX_GATHER}"),
-            ));
-        }
-        if max_depth as usize > MAX_DEPTH {
-            return Err(key_err(
-                Key::MaxDepth,
-                source(self.max_depth),
-                format!("{max_depth} exceeds the path stack capacity {MAX_DEPTH}"),
-            ));
-        }
-        let fixed = self.gather.is_some_and(|g| g.value == Gather::Radius);
-        Ok(settings.with_fixed_radius(fixed))
     }
 
     fn passes(&self) -> Result<u32, SceneError> {
@@ -418,6 +371,79 @@ impl SettingsInput {
     }
 }
 
+impl PhotonInput {
+    /// The values of `settings` as if a file had given them.
+    fn of(settings: &PhotonSettings) -> Self {
+        let gather = if settings.fixed_radius() {
+            Gather::Radius
+        } else {
+            Gather::Nearest
+        };
+        Self {
+            count: Some(Given::file(settings.count())),
+            k: Some(Given::file(settings.k())),
+            max_radius: Some(Given::file(settings.max_radius())),
+            max_depth: Some(Given::file(settings.max_depth())),
+            gather: Some(Given::file(gather)),
+        }
+    }
+
+    /// `self` with every value that `over` gives replaced by it.
+    fn overridden_by(&self, over: &PhotonInput) -> Self {
+        Self {
+            count: over.count.or(self.count),
+            k: over.k.or(self.k),
+            max_radius: over.max_radius.or(self.max_radius),
+            max_depth: over.max_depth.or(self.max_depth),
+            gather: over.gather.or(self.gather),
+        }
+    }
+
+    /// Validates the values against the core's constructor and the desktop's
+    /// capacities, with `default_radius` when no radius is given.
+    fn validate(&self, default_radius: impl FnOnce() -> f32) -> Result<PhotonSettings, SceneError> {
+        let value = |g: Option<Given<u32>>, default: u32| g.map_or(default, |g| g.value);
+        let source = |g: Option<Given<u32>>| g.map_or(Source::File, |g| g.source);
+        let k = value(self.k, DEFAULT_K);
+        let max_depth = value(self.max_depth, DEFAULT_MAX_DEPTH);
+        let radius = self.max_radius.map_or_else(default_radius, |g| g.value);
+        let settings = PhotonSettings::new(value(self.count, DEFAULT_COUNT), k, radius, max_depth)
+            .map_err(|e| {
+                // The core's labels of `PhotonSettings::new`, matched exactly.
+                let (key, src) = match e {
+                    Error::NotPositive {
+                        what: "photons.k", ..
+                    } => (Key::K, source(self.k)),
+                    Error::OutOfRange {
+                        what: "photons.max_depth",
+                        ..
+                    } => (Key::MaxDepth, source(self.max_depth)),
+                    _ => (
+                        Key::MaxRadius,
+                        self.max_radius.map_or(Source::File, |g| g.source),
+                    ),
+                };
+                key_err(key, src, problem(&e))
+            })?;
+        if k as usize > MAX_GATHER {
+            return Err(key_err(
+                Key::K,
+                source(self.k),
+                format!("{k} exceeds the gather capacity {MAX_GATHER}"),
+            ));
+        }
+        if max_depth as usize > MAX_DEPTH {
+            return Err(key_err(
+                Key::MaxDepth,
+                source(self.max_depth),
+                format!("{max_depth} exceeds the path stack capacity {MAX_DEPTH}"),
+            ));
+        }
+        let fixed = self.gather.is_some_and(|g| g.value == Gather::Radius);
+        Ok(settings.with_fixed_radius(fixed))
+    }
+}
+
 /// A gather radius for scenes that give none: a fortieth of the largest caustic
 /// object's bounding radius (scales with the scene), or 1/100 of the camera's distance
 /// from the origin when there is no bounded caustic object.
@@ -460,12 +486,12 @@ mod tests {
         }
         let cases: [fn(&mut SettingsInput, Source); 9] = [
             |s, src| s.passes = g(0, src),
-            |s, src| s.k = g(0, src),
-            |s, src| s.k = g(5000, src),
-            |s, src| s.max_depth = g(40, src),
-            |s, src| s.max_depth = g(999, src),
+            |s, src| s.photons.k = g(0, src),
+            |s, src| s.photons.k = g(5000, src),
+            |s, src| s.photons.max_depth = g(40, src),
+            |s, src| s.photons.max_depth = g(999, src),
             |s, src| {
-                s.max_radius = Some(Given {
+                s.photons.max_radius = Some(Given {
                     value: -1.0,
                     source: src,
                 })
@@ -498,13 +524,19 @@ mod tests {
     #[test]
     fn flags_override_only_what_they_give() {
         let file = SettingsInput {
-            count: Some(Given::file(10)),
-            gather: Some(Given::file(Gather::Radius)),
-            max_radius: Some(Given::file(0.5)),
+            photons: PhotonInput {
+                count: Some(Given::file(10)),
+                gather: Some(Given::file(Gather::Radius)),
+                max_radius: Some(Given::file(0.5)),
+                ..PhotonInput::default()
+            },
             ..SettingsInput::default()
         };
         let flags = SettingsInput {
-            count: Some(Given::flag(20)),
+            photons: PhotonInput {
+                count: Some(Given::flag(20)),
+                ..PhotonInput::default()
+            },
             ..SettingsInput::default()
         };
         let s = file.overridden_by(&flags).validate(&scene()).unwrap();

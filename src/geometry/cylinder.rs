@@ -20,14 +20,9 @@ pub struct Cylinder {
 }
 
 impl Cylinder {
-    /// A cylinder; radius and height must be positive, the axis non-zero.
-    pub fn new(
-        base: Vec3,
-        axis: Vec3,
-        radius: f32,
-        height: f32,
-        capped: bool,
-    ) -> Result<Self, Error> {
+    /// A capped cylinder (the paper's tube, and a scene file's default); radius and height
+    /// must be positive, the axis non-zero. [`Cylinder::with_caps`] opens it.
+    pub fn new(base: Vec3, axis: Vec3, radius: f32, height: f32) -> Result<Self, Error> {
         let base = finite_vec(base, "cylinder base")?;
         let axis = UnitVec3::try_new(axis, "cylinder axis")?;
         let radius = positive(radius, "cylinder radius")?;
@@ -41,9 +36,14 @@ impl Cylinder {
             e2,
             radius,
             height,
-            capped,
+            capped: true,
             error,
         })
+    }
+
+    /// The same cylinder closed by its two disks (`true`) or an open tube (`false`).
+    pub fn with_caps(self, capped: bool) -> Self {
+        Self { capped, ..self }
     }
 
     /// Centre of the bottom cap.
@@ -173,7 +173,7 @@ mod tests {
 
     #[test]
     fn side_caps_inside_and_parallel() {
-        let c = Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, 2.0, true).unwrap();
+        let c = Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, 2.0).unwrap();
         let h = c
             .intersect(&ray([-3.0, 1.0, 0.0], [1.0, 0.0, 0.0]), f32::INFINITY)
             .unwrap();
@@ -198,7 +198,9 @@ mod tests {
             .intersect(&ray([2.0, 5.0, 0.0], [0.0, -1.0, 0.0]), f32::INFINITY)
             .is_none());
         // Uncapped: down the axis passes straight through.
-        let open = Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, 2.0, false).unwrap();
+        let open = Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, 2.0)
+            .unwrap()
+            .with_caps(false);
         assert!(open
             .intersect(&ray([0.0, 5.0, 0.0], [0.0, -1.0, 0.0]), f32::INFINITY)
             .is_none());
@@ -212,7 +214,7 @@ mod tests {
     #[test]
     fn arbitrary_axis_agrees_with_brute_force() {
         let axis = Vec3::new(1.0, 2.0, -0.5);
-        let c = Cylinder::new(Vec3::new(0.5, -1.0, 4.0), axis, 0.7, 2.5, true).unwrap();
+        let c = Cylinder::new(Vec3::new(0.5, -1.0, 4.0), axis, 0.7, 2.5).unwrap();
         let inside = |p: Vec3| {
             let rel = p - c.base;
             let z = c.axis.dot(rel);
@@ -241,8 +243,8 @@ mod tests {
 
     #[test]
     fn rejects_bad_parameters() {
-        assert!(Cylinder::new(Vec3::ZERO, Vec3::ZERO, 1.0, 1.0, true).is_err());
-        assert!(Cylinder::new(Vec3::ZERO, Vec3::Y, 0.0, 1.0, true).is_err());
-        assert!(Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, -2.0, true).is_err());
+        assert!(Cylinder::new(Vec3::ZERO, Vec3::ZERO, 1.0, 1.0).is_err());
+        assert!(Cylinder::new(Vec3::ZERO, Vec3::Y, 0.0, 1.0).is_err());
+        assert!(Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, -2.0).is_err());
     }
 }

@@ -126,7 +126,7 @@ impl Shape {
         Cuboid::new(center, size, rotation_deg).map(Shape::Box)
     }
 
-    /// A cylinder; see [`Cylinder::new`].
+    /// A cylinder, closed or open; see [`Cylinder::new`] and [`Cylinder::with_caps`].
     pub fn cylinder(
         base: Vec3,
         axis: Vec3,
@@ -134,7 +134,7 @@ impl Shape {
         height: f32,
         capped: bool,
     ) -> Result<Self, Error> {
-        Cylinder::new(base, axis, radius, height, capped).map(Shape::Cylinder)
+        Cylinder::new(base, axis, radius, height).map(|c| Shape::Cylinder(c.with_caps(capped)))
     }
 
     /// A plane; see [`Plane::new`].

@@ -71,7 +71,7 @@ use heapless::Vec as FixedVec;
 
 use self::chart::{bounded_grids, pair, Grid, Profile};
 use super::{forward, CausticStore, ForwardStats, Photon, PhotonSettings};
-use crate::error::{positive, Error};
+use crate::error::{positive, within, Error};
 use crate::geometry::{Shape, SurfacePoint};
 use crate::material::Classic;
 use crate::math::{max_abs, Rgb, UnitVec3, Vec3};
@@ -102,13 +102,7 @@ impl<const N: usize> TexelStorage for [Rgb; N] {
         self
     }
     fn reserve(&mut self, needed: usize) -> Result<(), Error> {
-        if needed > N {
-            return Err(Error::Capacity {
-                what: "illumination map texels",
-                requested: needed,
-                capacity: N,
-            });
-        }
+        within(needed, N, "illumination map texels")?;
         Ok(())
     }
     fn capacity(&self) -> usize {
@@ -137,13 +131,8 @@ impl TexelStorage for std::vec::Vec<Rgb> {
     /// Grows to `needed` texels, up to `MAX_HEAP_TEXELS`: a layout beyond it (a tiny
     /// texel over photons scattered far) is an error, not an allocation that aborts.
     fn reserve(&mut self, needed: usize) -> Result<(), Error> {
-        if needed > MAX_HEAP_TEXELS {
-            return Err(Error::Capacity {
-                what: "illumination map texels (increase the texel size)",
-                requested: needed,
-                capacity: MAX_HEAP_TEXELS,
-            });
-        }
+        let what = "illumination map texels (increase the texel size)";
+        within(needed, MAX_HEAP_TEXELS, what)?;
         self.clear();
         self.resize(needed, Rgb::ZERO);
         self.shrink_to_fit();
@@ -309,8 +298,8 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
 
     /// The forward pass of `settings` with `seed` (pass 0), run two or three times
     /// (layout, plane trim if any, splat) and splatted without storing a photon: the
-    /// memory is the maps' alone. Splats exactly the photons [`shoot`](super::shoot)
-    /// would store, in the same order.
+    /// memory is the maps' alone. Splats exactly the photons
+    /// [`shoot_with_splats`](super::shoot_with_splats) would store, in the same order.
     pub fn build<const O: usize, const L: usize>(
         &mut self,
         scene: &Scene<O, L>,
@@ -453,13 +442,11 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
     /// chart keeps at least one texel: a budget below that is an error.
     fn fit_to_budget(&mut self) -> Result<(), Error> {
         let budget = self.budget.unwrap_or_else(|| self.texels.default_budget());
-        if budget > self.texels.capacity() {
-            return Err(Error::Capacity {
-                what: "illumination map texel budget",
-                requested: budget,
-                capacity: self.texels.capacity(),
-            });
-        }
+        within(
+            budget,
+            self.texels.capacity(),
+            "illumination map texel budget",
+        )?;
         let s = self.texel_size;
         let (mut need, mut least, mut photons) = (0.0f64, 0.0f64, 0.0f64);
         let mut order: FixedVec<usize, OBJECTS> = FixedVec::new();

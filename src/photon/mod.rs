@@ -3,16 +3,16 @@
 //!
 //! - [`emit`](self#emission): directions and powers (paper eq. 7, made uniform; projection maps),
 //! - `trace`: one photon's path,
-//! - [`kdtree`]: the left-balanced kd-tree built in place,
+//! - `kdtree`: the left-balanced kd-tree built in place ([`KdTree`], [`balance`]),
 //! - `estimate`: the radiance estimate (Jensen; paper eq. 8).
 //!
 //! # Emission
-//! See the `emit` module's formulas, repeated on [`shoot`].
+//! See the `emit` module's formulas, repeated on [`shoot_with_splats`].
 
 mod emit;
 mod estimate;
 mod illumination;
-pub mod kdtree;
+mod kdtree;
 mod packed;
 mod splat;
 mod trace;
@@ -24,14 +24,14 @@ pub use illumination::{
 #[cfg(feature = "std")]
 pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
 pub use kdtree::{
-    balance, balance_finish, balance_subtree, balance_top, KdTree, Neighbor, Subtree,
+    balance, balance_finish, balance_subtree, balance_top, Found, KdTree, Neighbor, Subtree,
 };
 pub use packed::Photon;
 pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;
 
-use crate::error::{in_range, positive, Error};
+use crate::error::{in_range, positive, within, Error};
 use crate::geometry::Ray;
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
@@ -125,49 +125,58 @@ impl PhotonSettings {
     }
 
     /// With Jensen's cone filter.
-    pub fn with_cone_filter(mut self, cone: Option<ConeFilter>) -> Self {
-        self.cone = cone;
-        self
+    pub fn with_cone_filter(self, cone: Option<ConeFilter>) -> Self {
+        Self { cone, ..self }
+    }
+
+    /// The cone filter, if any.
+    pub fn cone_filter(&self) -> Option<ConeFilter> {
+        self.cone
     }
 
     /// Emits over the light's whole sphere instead of through projection maps
     /// (for measuring what the projection maps save).
-    pub fn with_full_sphere(mut self, full_sphere: bool) -> Self {
-        self.full_sphere = full_sphere;
-        self
+    pub fn with_full_sphere(self, full_sphere: bool) -> Self {
+        Self {
+            full_sphere,
+            ..self
+        }
     }
 
     /// Also stores photons at their first (direct) hit: the map then holds direct
     /// light too. For tests of the density estimate; never for rendering, where direct
     /// light comes from shadow rays.
-    pub fn with_direct_photons(mut self, store_direct: bool) -> Self {
-        self.store_direct = store_direct;
-        self
+    pub fn with_direct_photons(self, store_direct: bool) -> Self {
+        Self {
+            store_direct,
+            ..self
+        }
     }
 
     /// Gathers every photon within `max_radius` instead of the `k` nearest: the
     /// estimate of progressive photon mapping, whose radius shrinks pass by pass.
-    pub fn with_fixed_radius(mut self, fixed_radius: bool) -> Self {
-        self.fixed_radius = fixed_radius;
-        self
-    }
-
-    /// Whether the forward pass connects each landed photon to the eye (light tracing
-    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
-    /// backward pass gathers at every diffuse hit, as in the paper.
-    pub fn with_camera_splats(mut self, splat: bool) -> Self {
-        self.splat = splat;
-        self
-    }
-
-    /// `true` when landed photons are connected to the eye.
-    pub fn camera_splats(&self) -> bool {
-        self.splat
+    pub fn with_fixed_radius(self, fixed_radius: bool) -> Self {
+        Self {
+            fixed_radius,
+            ..self
+        }
     }
 
     /// `true` when every photon within `max_radius` is gathered.
     pub fn fixed_radius(&self) -> bool {
         self.fixed_radius
+    }
+
+    /// Whether the forward pass connects each landed photon to the eye (light tracing
+    /// of the caustics seen directly: see [`Splat`]). On by default; off, the
+    /// backward pass gathers at every diffuse hit, as in the paper.
+    pub fn with_camera_splats(self, splat: bool) -> Self {
+        Self { splat, ..self }
+    }
+
+    /// `true` when landed photons are connected to the eye.
+    pub fn camera_splats(&self) -> bool {
+        self.splat
     }
 
     /// A copy with another maximum radius (progressive passes shrink it).
@@ -191,10 +200,6 @@ impl PhotonSettings {
     /// Specular interactions per path.
     pub fn max_depth(&self) -> u32 {
         self.max_depth
-    }
-    /// The cone filter, if any.
-    pub fn cone_filter(&self) -> Option<ConeFilter> {
-        self.cone
     }
 }
 
@@ -419,7 +424,7 @@ pub fn forward<const O: usize, const L: usize>(
     Ok(stats)
 }
 
-/// The forward pass of [`shoot`], handing each photon it would store to `f` instead of
+/// The forward pass of [`shoot_with_splats`], handing each photon it would store to `f` instead of
 /// writing it to an array: the same photons, in the same order, with the same power
 /// unit. Needs no photon memory at all (the illumination maps splat as they go).
 pub fn for_each_photon<const O: usize, const L: usize>(
@@ -439,20 +444,9 @@ pub fn for_each_photon<const O: usize, const L: usize>(
 
 /// The forward pass: shoots `settings.count` photons from each light (see [`Emitter`])
 /// and stores those that land on a diffuse surface after a specular bounce, in
-/// emission order, into `out[..stored]` (not yet balanced). An error when `out` cannot
-/// hold `count × lights` photons. Camera splats are not kept: see [`shoot_with_splats`].
-pub fn shoot<const O: usize, const L: usize>(
-    scene: &Scene<O, L>,
-    settings: &PhotonSettings,
-    seed: u64,
-    pass: u32,
-    out: &mut [Photon],
-) -> Result<ForwardStats, Error> {
-    shoot_with_splats(scene, settings, seed, pass, out, &mut ())
-}
-
-/// As [`shoot`], also keeping the camera splats (see [`Splat`]) in `splats`, emptied
-/// first. An error when `splats` is full.
+/// emission order, into `out[..stored]` (not yet balanced), and the camera splats (see
+/// [`Splat`]) into `splats`, emptied first (`&mut ()` keeps none). An error when `out`
+/// cannot hold `count × lights` photons or `splats` is full.
 pub fn shoot_with_splats<const O: usize, const L: usize>(
     scene: &Scene<O, L>,
     settings: &PhotonSettings,
@@ -461,14 +455,11 @@ pub fn shoot_with_splats<const O: usize, const L: usize>(
     out: &mut [Photon],
     splats: &mut impl SplatStorage,
 ) -> Result<ForwardStats, Error> {
-    let needed = photons_needed(scene, settings);
-    if needed > out.len() {
-        return Err(Error::Capacity {
-            what: "photons (count × lights)",
-            requested: needed,
-            capacity: out.len(),
-        });
-    }
+    within(
+        photons_needed(scene, settings),
+        out.len(),
+        "photons (count × lights)",
+    )?;
     splats.clear_splats();
     let mut n = 0;
     forward(scene, settings, seed, pass, |x| {
@@ -506,7 +497,7 @@ impl<const N: usize> PhotonMap<N> {
         }
     }
 
-    /// Runs the forward pass into this map and balances it: see [`shoot`]. The
+    /// Runs the forward pass into this map and balances it: see [`shoot_with_splats`]. The
     /// camera's splats are dropped: see [`build_with_splats`](Self::build_with_splats).
     pub fn build<const O: usize, const L: usize>(
         &mut self,

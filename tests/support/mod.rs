@@ -1,4 +1,5 @@
-//! What several integration tests share: reading the example scenes, a small
+//! What several integration tests share: reading the example scenes, the parts of
+//! hand-built scenes ([`add_floor`], [`add_glass_sphere`], [`add_light`]), a small
 //! deterministic generator, FNV-1a, and the generator of hostile scenes
 //! ([`hostile`]), and the firmware's pipeline on the host ([`device`]). Each test
 //! file takes it with `mod support;` and uses a part of it.
@@ -7,7 +8,12 @@
 pub mod device;
 pub mod hostile;
 
+use caustic::geometry::Shape;
+use caustic::light::PointLight;
+use caustic::material::Material;
+use caustic::math::{Rgb, Vec3};
 use caustic::sampling::mix64;
+use caustic::scene::Scene;
 
 /// The text of `scenes/<name>`.
 pub fn scene_text(name: &str) -> String {
@@ -19,6 +25,58 @@ pub fn scene_text(name: &str) -> String {
 pub fn data_text(name: &str) -> String {
     let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Adds the floor `y = 0`, diffuse with `albedo`, to `scene`.
+pub fn add_floor<const O: usize, const L: usize>(scene: &mut Scene<O, L>, albedo: Rgb) {
+    let floor = Shape::plane(Vec3::ZERO, Vec3::Y).unwrap();
+    scene
+        .add(floor, Material::diffuse(albedo).unwrap())
+        .unwrap();
+}
+
+/// Adds a sphere of clear glass (ior 1.5, no absorption) to `scene`.
+pub fn add_glass_sphere<const O: usize, const L: usize>(
+    scene: &mut Scene<O, L>,
+    center: Vec3,
+    radius: f32,
+) {
+    let glass = Material::dielectric(1.5, Rgb::ZERO).unwrap();
+    scene
+        .add(Shape::sphere(center, radius).unwrap(), glass)
+        .unwrap();
+}
+
+/// Adds a point light at `position` of `intensity` to `scene`.
+pub fn add_light<const O: usize, const L: usize>(
+    scene: &mut Scene<O, L>,
+    position: Vec3,
+    intensity: Rgb,
+) {
+    let light = PointLight::new(position, intensity).unwrap();
+    scene.add_light(light).unwrap();
+}
+
+/// The worst relative error of `irradiance(x)` against a point light's `I·cosθ/d²`
+/// (`light` at `intensity`) at 40 points `x` of the floor `y = 0`, on a spiral whose
+/// radius grows by `step` a point.
+pub fn worst_floor_irradiance_error(
+    light: Vec3,
+    intensity: f32,
+    step: f32,
+    mut irradiance: impl FnMut(Vec3) -> f64,
+) -> f64 {
+    let mut worst = 0.0f64;
+    for i in 0..40 {
+        let a = i as f32 * 0.61;
+        let r = step * i as f32;
+        let x = Vec3::new(r * a.cos(), 0.0, r * a.sin());
+        let e = irradiance(x);
+        let to = (light - x).as_dvec3();
+        let want = intensity as f64 * (to.y / to.length()) / to.length_squared();
+        worst = worst.max((e - want).abs() / want);
+    }
+    worst
 }
 
 /// FNV-1a (32-bit) of a byte stream, as the firmware prints it (`PASS fnv1a=0x…`).

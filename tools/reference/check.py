@@ -22,32 +22,10 @@ import numpy as np
 
 import pixel
 import reference as R
+from metrics import binned, caustic_mask, rel_rmse
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-
-
-def lum(a):
-    return a.mean(axis=-1)
-
-
-def rel_rmse(a, b, mask=None):
-    """sqrt(mean |a-b|^2) / mean((a+b)/2), over the mask (all channels)."""
-    if mask is None:
-        mask = np.ones(a.shape[:2], bool)
-    d = (a - b)[mask]
-    m = (0.5 * (a + b))[mask].mean()
-    return float(np.sqrt((d ** 2).mean()) / m) if m > 0 else float("nan")
-
-
-def caustic_mask(caustic, full):
-    """Caustic region: pixels whose caustic part is >= 10 % of the pixel's luminance."""
-    return lum(caustic) >= 0.1 * lum(full)
-
-
-def bin2(a):
-    H, W = a.shape[:2]
-    return a[: H // 2 * 2, : W // 2 * 2].reshape(H // 2, 2, W // 2, 2, -1).mean(axis=(1, 3))
 
 
 # ----------------------------------------------------------------------------- check 1
@@ -160,9 +138,9 @@ def compare_pair(A, B):
                pair_rel_rmse_full=rel_rmse(A["full"], B["full"]),
                pair_rel_rmse_caustic_region=rel_rmse(A["full"], B["full"], mask),
                pair_rel_rmse_caustic_part_in_region=rel_rmse(A["caustic"], B["caustic"], mask))
-    m2 = bin2(mask[..., None].astype(float))[..., 0] > 0.5
-    res["pair_rel_rmse_full_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]))
-    res["pair_rel_rmse_caustic_region_2x2"] = rel_rmse(bin2(A["full"]), bin2(B["full"]), m2)
+    m2 = binned(mask[..., None].astype(float), 2)[..., 0] > 0.5
+    res["pair_rel_rmse_full_2x2"] = rel_rmse(binned(A["full"], 2), binned(B["full"], 2))
+    res["pair_rel_rmse_caustic_region_2x2"] = rel_rmse(binned(A["full"], 2), binned(B["full"], 2), m2)
     if "gather2" in A and "gather2" in B:
         # kernel bias of the gather: bias(r) ~ D (edges, bias ~ r) or D/3 (smooth, ~ r^2),
         # D = gather(2r) - gather(r) on the same vertices and photons, mean of both seeds

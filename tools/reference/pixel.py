@@ -123,10 +123,7 @@ def trace_samples(scene, geo, cam, pix, rng, pmap, fresnel_rng=None):
     while len(o):
         rays += len(o)
         t, obj, p, n = geo.intersect(o, d)
-        for i, ob in enumerate(objs):
-            m = (medium == i) & np.isfinite(t)
-            if m.any() and ob["mat"]["type"] == "dielectric":
-                w[m] *= np.exp(-ob["mat"]["absorption"][None] * t[m, None])
+        R.absorb(w, objs, medium, t)
         miss = obj < 0
         _acc(out["background"], sid[miss], w[miss] * scene["background"][None])
         new = []

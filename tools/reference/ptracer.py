@@ -30,23 +30,7 @@ import time
 import numpy as np
 
 import reference as R
-
-
-def lum(a):
-    return a.mean(axis=-1)
-
-
-def rel_rmse(a, b, mask=None):
-    if mask is None:
-        mask = np.ones(a.shape[:2], bool)
-    d = (a - b)[mask]
-    m = (0.5 * (a + b))[mask].mean()
-    return float(np.sqrt((d ** 2).mean()) / m)
-
-
-def binb(a, b):
-    H, W = a.shape[:2]
-    return a[: H // b * b, : W // b * b].reshape(H // b, b, W // b, b, -1).mean(axis=(1, 3))
+from metrics import binned, caustic_mask, rel_rmse
 
 
 def mitsuba_scene(js, W, H, albedo_scale, max_depth, integrator="ptracer"):
@@ -144,14 +128,14 @@ def main(argv):
         ref2 = R.read_pfm(args.ref2 + ".direct_seen.pfm") + R.read_pfm(f"{args.ref2}.{other}.pfm")
         splat = 0.5 * (splat + R.read_pfm(f"{args.ref2}.{other}.pfm"))
     refm = ref if ref2 is None else 0.5 * (ref + ref2)
-    mask = lum(splat) >= 0.1 * lum(refm)
+    mask = caustic_mask(splat, refm)
     res = dict(integrator=args.integrator, compared_parts=["direct_seen", other], region=f"{other} >= 10% of the pixel",
                spp=args.spp, max_depth=args.max_depth, caustic_px=int(mask.sum()), seconds=times)
     for b in (1, 4, 8):
-        m = binb(mask[..., None].astype(float), b)[..., 0] > 0.5
-        L = {s: binb(lin[s], b) for s in (1, 2)}
-        P = {s: binb(rho[s], b) for s in (1, 2)}
-        Rm = binb(refm, b)
+        m = binned(mask[..., None].astype(float), b)[..., 0] > 0.5
+        L = {s: binned(lin[s], b) for s in (1, 2)}
+        P = {s: binned(rho[s], b) for s in (1, 2)}
+        Rm = binned(refm, b)
         la, pa = 0.5 * (L[1] + L[2]), 0.5 * (P[1] + P[2])
         row = {}
         for name, mk in (("full", None), ("region", m)):
@@ -162,7 +146,7 @@ def main(argv):
                      sum_rho_over_ref=float(pa[mk if mk is not None else ...].sum() / Rm[mk if mk is not None else ...].sum()))
             exp2 = lin_pair ** 2 / 4
             if ref2 is not None:
-                ref_pair = rel_rmse(binb(ref, b), binb(ref2, b), mk)
+                ref_pair = rel_rmse(binned(ref, b), binned(ref2, b), mk)
                 r["ref_pair"] = ref_pair
                 exp2 += ref_pair ** 2 / 4
             r["expected_from_noise"] = math.sqrt(exp2)

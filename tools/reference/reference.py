@@ -317,6 +317,15 @@ def fresnel_refract(d, n, ior):
     return F, t_dir, tir, eta_i, eta_t, entering
 
 
+def absorb(w, objs, medium, t):
+    """Beer-Lambert over the segments just traced: scales in place the weights `w` of the
+    rays inside dielectric `medium` (an object index, -1 outside) by exp(-absorption t)."""
+    for i, ob in enumerate(objs):
+        m = (medium == i) & np.isfinite(t)
+        if m.any() and ob["mat"]["type"] == "dielectric":
+            w[m] *= np.exp(-ob["mat"]["absorption"][None] * t[m, None])
+
+
 def offset(p, n, d):
     s = np.sign(np.sum(d * n, axis=1))
     s[s == 0] = 1
@@ -444,10 +453,7 @@ def trace_photons(scene, geo, emitter, rng, n):
     while len(o):
         rays += len(o)
         t, obj, p, nrm = geo.intersect(o, d)
-        for i, ob in enumerate(objs):
-            m = (medium == i) & np.isfinite(t)
-            if m.any() and ob["mat"]["type"] == "dielectric":
-                pw[m] *= np.exp(-ob["mat"]["absorption"][None] * t[m, None])
+        absorb(pw, objs, medium, t)
         hit = obj >= 0
         no, nd, npw, nns, nmd = [], [], [], [], []
         for i, ob in enumerate(objs):
