@@ -441,9 +441,18 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
-                let reflected = branch(r, b.weight * c.reflectivity);
-                let t = interface(d, facing, eta).refracted.unwrap_or(r);
-                let refracted = branch(t, b.weight * c.transparency);
+                // Under total internal reflection the transmitted part follows the
+                // reflected ray: one ray carries both.
+                let (reflected, refracted) = match interface(d, facing, eta).refracted {
+                    Some(t) => (
+                        branch(r, b.weight * c.reflectivity),
+                        branch(t, b.weight * c.transparency),
+                    ),
+                    None => (
+                        branch(r, b.weight * (c.reflectivity + c.transparency)),
+                        None,
+                    ),
+                };
                 (b.weight * local, reflected, refracted)
             }
             // A specular surface after max_depth interactions contributes nothing.
