@@ -333,20 +333,22 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             };
             out.mix(index as u32 | b.depth << 16);
             let material = &self.scene.objects()[index].material;
-            let (local, mut first, mut second) = self.scatter(&b, &hit, material, count, &mut out);
+            let (local, first, second) = self.scatter(&b, &hit, material, count, &mut out);
             out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
             let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
-            if sum(&second) > sum(&first) {
-                core::mem::swap(&mut first, &mut second);
-            }
-            next = first;
-            if let Some(s) = second {
+            let (heavier, lighter) = if sum(&second) > sum(&first) {
+                (second, first)
+            } else {
+                (first, second)
+            };
+            if let Some(s) = lighter {
                 if stack.push(s).is_err() {
                     debug_assert!(false, "path stack overflow: DEPTH < max_depth");
                 }
             }
+            next = heavier;
         }
         out
     }

@@ -140,6 +140,15 @@ marker!(caustic_mark_photons_end, 2u32);
 marker!(caustic_mark_render_begin, 3u32);
 marker!(caustic_mark_render_end, 4u32);
 
+/// A count for printing, as `u32`: formatting a `u64` links a 64-bit division
+/// (1.1 KiB of flash). A device render's counts stay far below 2³² (the ray budget
+/// bounds a pixel's rays); a larger one would print as `u32::MAX`, never wrapped.
+fn count(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+// The seed is printed as a `u32` (see `count`).
+const _: () = assert!(BUDGET.seed <= u32::MAX as u64);
+
 /// Stops with a failure. The core's `Error` is not formatted: its `Display` prints
 /// `f32` fields, and float formatting alone is about 16 KiB of flash. The host test
 /// (`tests/device.rs`) runs the same code and shows the error's text.
@@ -156,7 +165,7 @@ pub fn run() -> ! {
         scene::NAME,
         BUDGET.width,
         BUDGET.height,
-        BUDGET.seed
+        BUDGET.seed as u32
     );
     let Statics { map, row, path } = take_statics().unwrap_or_else(|| fail("statics taken twice"));
     let path = semihosting::output_path(path, scene::FILE);
@@ -171,7 +180,7 @@ pub fn run() -> ! {
     let forward = forward.unwrap_or_else(|_| fail("forward pass: over budget"));
     hprintln!(
         "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
-        forward.emitted,
+        count(forward.emitted),
         forward.stored,
         BUDGET.stored,
         map.splats().len(),
@@ -200,7 +209,11 @@ pub fn run() -> ! {
     let (pixels, hash, complete) = (stream.pixels(), stream.hash(), stream.is_complete());
     let _ = stream.into_writer(); // gives `file` back
     file.close().unwrap_or_else(|e| fail(e));
-    hprintln!("rays: {} eye, {} shadow", rays.eye, rays.shadow);
+    hprintln!(
+        "rays: {} eye, {} shadow",
+        count(rays.eye),
+        count(rays.shadow)
+    );
     let (stack, reserved) = stack_high_water();
     hprintln!(
         "stack high-water: {} bytes (of {} reserved)",
