@@ -12,8 +12,12 @@
 //! `caustic::raster::Rgb565Stream` whose bytes (little-endian RGB565, row-major) are
 //! appended to a file on the host by semihosting. No frame buffer exists on the device.
 //!
-//! Output (semihosting stdout): the photon and ray counts, the stack's high-water mark,
-//! and `PASS fnv1a=0x…`, the FNV-1a of the RGB565 bytes. QEMU exits with 0 on success
+//! Output (semihosting stdout): the photon and ray counts, with `--features
+//! error-estimate` the render's estimate of its own error (`error_estimate rel_rmse=…
+//! rel_rmse_caustic=…`: the rows are `caustic::render::PixelEstimate`s, tallied as the
+//! desktop tallies them, printed by `caustic::budget::ErrorFigure` with integer
+//! arithmetic), the stack's high-water mark, and `PASS fnv1a=0x…`, the FNV-1a of the
+//! RGB565 bytes. QEMU exits with 0 on success
 //! and 1 on any failure, panic or fault. The output path is the second word of the
 //! semihosting command line (`arg=caustic,arg=PATH`), else `fig6.rgb565` (`glass.rgb565`).
 //!
@@ -38,9 +42,9 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use caustic::budget::DeviceMap;
-use caustic::math::Rgb;
 use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
 use caustic::render::Renderer;
+use estimate::{Pixel, Tally};
 use semihosting::HostFile;
 
 /// The scene: Fig. 6 by default; `--features glass` builds the physical scene.
@@ -66,11 +70,71 @@ const TARGET: &str = env!("CAUSTIC_FIRMWARE_TARGET");
 /// Row length, pixels.
 const WIDTH: usize = BUDGET.width as usize;
 
+/// The render's estimate of its own error (`--features error-estimate`): rows of
+/// `PixelEstimate`s (radiance, caustic part, error terms) tallied row by row. It costs
+/// Fig. 6 on the Cortex-M4F about 5 KiB of flash (soft-float `f64` sums and ratio,
+/// digits) and 2 M instructions, more than its budget leaves: the glass firmwares carry
+/// it (tools/device/run.sh).
+#[cfg(feature = "error-estimate")]
+mod estimate {
+    use crate::hprintln;
+    use caustic::budget::ErrorFigure;
+    use caustic::math::Rgb;
+    use caustic::render::{ErrorTally, PixelEstimate};
+
+    /// A row's pixel: radiance with its caustic part and error terms.
+    pub type Pixel = PixelEstimate;
+    /// The pixel a row starts as.
+    pub const BLANK: Pixel = PixelEstimate {
+        radiance: Rgb::ZERO,
+        caustic: Rgb::ZERO,
+        split: Rgb::ZERO,
+        sampling2: Rgb::ZERO,
+    };
+
+    /// The tally of every finished row.
+    #[derive(Default)]
+    pub struct Tally(ErrorTally);
+
+    impl Tally {
+        /// Adds a finished row (splats included).
+        pub fn add(&mut self, row: &[Pixel]) {
+            self.0.add_row(row);
+        }
+
+        /// Prints the estimate, as the host test prints it.
+        pub fn report(&self) {
+            hprintln!("error_estimate {}", ErrorFigure(self.0));
+        }
+    }
+}
+/// Without the error estimate: rows of radiance, nothing tallied.
+#[cfg(not(feature = "error-estimate"))]
+mod estimate {
+    use caustic::math::Rgb;
+
+    /// A row's pixel: linear radiance.
+    pub type Pixel = Rgb;
+    /// The pixel a row starts as.
+    pub const BLANK: Pixel = Rgb::ZERO;
+
+    /// Nothing to tally.
+    #[derive(Default)]
+    pub struct Tally;
+
+    impl Tally {
+        /// Nothing to add.
+        pub fn add(&mut self, _: &[Pixel]) {}
+        /// Nothing to print.
+        pub fn report(&self) {}
+    }
+}
+
 /// What the render keeps outside the stack: the photon map (in `.bss`, counted by
-/// the linker), the row of linear radiance, and the output path.
+/// the linker), the row of pixels, and the output path.
 struct Statics {
     map: DeviceMap<{ BUDGET.stored }, { BUDGET.splats }>,
-    row: [Rgb; WIDTH],
+    row: [Pixel; WIDTH],
     path: [u8; 256],
 }
 
@@ -83,7 +147,7 @@ unsafe impl Sync for StaticsCell {}
 
 static STATICS: StaticsCell = StaticsCell(UnsafeCell::new(Statics {
     map: DeviceMap::new(),
-    row: [Rgb::ZERO; WIDTH],
+    row: [estimate::BLANK; WIDTH],
     path: [0; 256],
 }));
 static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -198,10 +262,14 @@ pub fn run() -> ! {
         Rgb565Stream::<_, WIDTH>::new(BUDGET.width, BUDGET.height, |b: &[u8]| file.write(b))
             .unwrap_or_else(|_| fail("display"));
 
+    let mut tally = Tally::default();
     caustic_mark_render_begin();
     let rays = {
         let mut sink = DisplaySink::new(&mut stream, ToneMap::default(), Dither::Off);
-        renderer.rows(row, |y, pixels| sink.draw_row(y, pixels))
+        renderer.rows(row, |y, pixels| {
+            tally.add(pixels);
+            sink.draw_row(y, pixels)
+        })
     };
     caustic_mark_render_end();
     let rays = rays.unwrap_or_else(|_| fail("writing the image"));
@@ -214,6 +282,7 @@ pub fn run() -> ! {
         count(rays.eye),
         count(rays.shadow)
     );
+    tally.report();
     let (stack, reserved) = stack_high_water();
     hprintln!(
         "stack high-water: {} bytes (of {} reserved)",
