@@ -12,24 +12,25 @@
 //! - [`DeviceMap`]: a photon map sized to what is stored, not to what is emitted;
 //!   `size_of::<DeviceMap<N>>()` is its whole memory;
 //! - [`DeviceMemory`]: everything a device render keeps in RAM outside the stack
-//!   (scene, map, one row), so `size_of` tells the whole static memory.
+//!   (scene, map, one row), so `size_of` tells the whole static memory;
+//! - [`ErrorFigure`]: the render's estimate of its own error as the firmware prints
+//!   it, formatted with integer arithmetic (the host prints the same digits).
 //!
 //! ```
 //! use caustic::budget::{DeviceMemory, FIG6};
 //! // Fig. 6 on a device: the scene, a map of FIG6.stored photons and FIG6.splats
-//! // splats, one row of 160 pixels.
+//! // splats, one row of 160 pixels with their error estimates.
 //! type Fig6 = DeviceMemory<2, 1, { FIG6.stored }, { FIG6.splats }, { FIG6.width as usize }>;
 //! let bytes = core::mem::size_of::<Fig6>();
-//! assert!(bytes <= 24 * 1024, "{bytes}");
+//! assert!(bytes <= 28 * 1024, "{bytes}");
 //! ```
 
 use crate::error::Error;
-use crate::math::Rgb;
 use crate::photon::{
     self, balance, CausticStore, ForwardStats, KdStore, KdTree, Photon, PhotonSettings, Splat,
     SplatStorage,
 };
-use crate::render::Renderer;
+use crate::render::{ErrorTally, PixelEstimate, Renderer};
 use crate::scene::Scene;
 
 /// A device build's capacities and work. All fields are plain constants so that they
@@ -140,14 +141,14 @@ const _: () = assert!(check::<
     { FIG6.stored },
     { FIG6.splats },
     { FIG6.width as usize },
->(&FIG6, 24 * 1024));
+>(&FIG6, 28 * 1024));
 const _: () = assert!(check::<
     GLASS_OBJECTS,
     GLASS_LIGHTS,
     { GLASS.stored },
     { GLASS.splats },
     { GLASS.width as usize },
->(&GLASS, 40 * 1024));
+>(&GLASS, 44 * 1024));
 const _: () = assert!(core::mem::size_of::<Photon>() <= 16);
 
 /// A photon map that holds at most `STORED` photons of a forward pass that may emit
@@ -268,7 +269,8 @@ impl<const STORED: usize, const SPLATS: usize> DeviceMap<STORED, SPLATS> {
 }
 
 /// Everything a device render keeps in RAM outside the stack: the scene (`O` objects,
-/// `L` lights), the photon map (`N` photons, `S` splats) and one row of `W` pixels.
+/// `L` lights), the photon map (`N` photons, `S` splats) and one row of `W` pixels
+/// (each with its caustic part and error terms, for the error estimate).
 /// The firmware keeps the map and the row in statics and the scene on the stack; this
 /// type only states the sum, so that `size_of` gives it.
 #[derive(Debug)]
@@ -283,8 +285,47 @@ pub struct DeviceMemory<
     pub scene: Scene<O, L>,
     /// The photon map.
     pub map: DeviceMap<N, S>,
-    /// One row of linear radiance.
-    pub row: [Rgb; W],
+    /// One row of pixels: linear radiance and its estimated error.
+    pub row: [PixelEstimate; W],
+}
+
+/// A render's estimate of its own error ([`ErrorTally`]) as a device prints it:
+/// `rel_rmse=0.0123 rel_rmse_caustic=0.0456`, each rounded half up to four decimals
+/// (`none` where the figure is undefined: a black image, no caustic pixel).
+///
+/// Formatted with integer arithmetic only (float formatting would cost a device about
+/// 16 KiB of flash), and from the tally's `f64` sums, which the host and the device
+/// compute bit for bit alike: the host prints the same digits.
+///
+/// ```
+/// use caustic::budget::ErrorFigure;
+/// use caustic::render::ErrorTally;
+/// assert_eq!(
+///     ErrorFigure(ErrorTally::default()).to_string(),
+///     "rel_rmse=none rel_rmse_caustic=none"
+/// );
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorFigure(pub ErrorTally);
+
+impl core::fmt::Display for ErrorFigure {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("rel_rmse=")?;
+        fixed4(f, self.0.rel_rmse())?;
+        f.write_str(" rel_rmse_caustic=")?;
+        fixed4(f, self.0.rel_rmse_caustic())
+    }
+}
+
+/// `x ≥ 0` rounded half up to four decimals (saturating at 429 496.7295), or `none`.
+fn fixed4(f: &mut core::fmt::Formatter<'_>, x: Option<f64>) -> core::fmt::Result {
+    match x {
+        Some(x) => {
+            let n = (x * 10_000.0 + 0.5) as u32;
+            write!(f, "{}.{:04}", n / 10_000, n % 10_000)
+        }
+        None => f.write_str("none"),
+    }
 }
 
 #[cfg(test)]
@@ -329,6 +370,45 @@ mod tests {
             seen <= GLASS.splats && seen > GLASS.splats * 9 / 10,
             "{seen}"
         );
+    }
+
+    #[test]
+    fn the_error_figure_is_the_tallys_ratio_to_four_decimals() {
+        extern crate std;
+        use crate::math::Rgb;
+        use std::string::ToString;
+        let lit = PixelEstimate {
+            radiance: Rgb::ONE,
+            caustic: Rgb::ONE,
+            split: Rgb::new(0.01, 0.0, 0.0),
+            sampling2: Rgb::ZERO,
+        };
+        let plain = PixelEstimate {
+            radiance: Rgb::ONE,
+            ..PixelEstimate::default()
+        };
+        let mut t = ErrorTally::default();
+        t.add_row(&[lit, plain]);
+        // sqrt(1e-4 · 3 · 2) / 6 = 0.0040825; the caustic pixel alone: sqrt(3e-4)/3 = 0.0057735.
+        assert_eq!(
+            ErrorFigure(t).to_string(),
+            "rel_rmse=0.0041 rel_rmse_caustic=0.0058"
+        );
+        let mut dark = ErrorTally::default();
+        dark.add_row(&[plain]);
+        assert_eq!(
+            ErrorFigure(dark).to_string(),
+            "rel_rmse=0.0000 rel_rmse_caustic=none"
+        );
+        // Whole units and the carry of a rounding: 1.23456 -> 1.2346, 0.99996 -> 1.0000.
+        struct Show(f64);
+        impl core::fmt::Display for Show {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                fixed4(f, Some(self.0))
+            }
+        }
+        assert_eq!(Show(1.23456).to_string(), "1.2346");
+        assert_eq!(Show(0.99996).to_string(), "1.0000");
     }
 
     #[test]

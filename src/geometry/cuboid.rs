@@ -266,28 +266,19 @@ mod tests {
 
     #[test]
     fn rotation_applies_x_then_y_then_z() {
-        // Rotating a 2×4×6 box 90° about Z maps its local x (half 1) to world y.
-        let b = Cuboid::new(
-            Vec3::ZERO,
-            Vec3::new(2.0, 4.0, 6.0),
-            Vec3::new(0.0, 0.0, 90.0),
-        )
-        .unwrap();
-        let h = b
-            .intersect(&ray([0.0, 5.0, 0.0], [0.0, -1.0, 0.0]), f32::INFINITY)
-            .unwrap();
+        // A 2×4×6 box at the origin turned by `deg`, hit by a ray down −y from (0, y, 0).
+        let down = |deg: Vec3, y: f32| {
+            Cuboid::new(Vec3::ZERO, Vec3::new(2.0, 4.0, 6.0), deg)
+                .unwrap()
+                .intersect(&ray([0.0, y, 0.0], [0.0, -1.0, 0.0]), f32::INFINITY)
+                .unwrap()
+        };
+        // 90° about Z maps its local x (half 1) to world y.
+        let h = down(Vec3::new(0.0, 0.0, 90.0), 5.0);
         assert!((h.t - 4.0).abs() < 1e-5, "{}", h.t);
         assert!((h.normal.get() - Vec3::Y).length() < 1e-6);
         // X then Y: local z (half 3) → after Rx(90°) along −y → Ry leaves y alone.
-        let b = Cuboid::new(
-            Vec3::ZERO,
-            Vec3::new(2.0, 4.0, 6.0),
-            Vec3::new(90.0, 90.0, 0.0),
-        )
-        .unwrap();
-        let h = b
-            .intersect(&ray([0.0, 9.0, 0.0], [0.0, -1.0, 0.0]), f32::INFINITY)
-            .unwrap();
+        let h = down(Vec3::new(90.0, 90.0, 0.0), 9.0);
         assert!((h.t - 6.0).abs() < 1e-5, "{}", h.t);
     }
 

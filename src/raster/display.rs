@@ -69,12 +69,16 @@ where
         }
     }
 
-    /// Draws `row` as display row `y`, from column 0.
-    pub fn draw_row(&mut self, y: u32, row: &[Rgb]) -> Result<(), D::Error> {
+    /// Draws `row` as display row `y`, from column 0: radiance (`Rgb`), or any pixel
+    /// that gives one (a [`PixelEstimate`](crate::render::PixelEstimate) draws its value).
+    pub fn draw_row<P: Copy>(&mut self, y: u32, row: &[P]) -> Result<(), D::Error>
+    where
+        Rgb: From<P>,
+    {
         let area = Rectangle::new(Point::new(0, y as i32), Size::new(row.len() as u32, 1));
         let (tone, dither) = (self.tone, self.dither);
         let colors = row.iter().enumerate().map(move |(x, &c)| {
-            let [r, g, b] = tone.srgb8(c);
+            let [r, g, b] = tone.srgb8(Rgb::from(c));
             let [r, g, b] = match dither {
                 Dither::Off => [r, g, b],
                 Dither::Bayer565 => {

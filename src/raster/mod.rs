@@ -104,15 +104,16 @@ impl ToneMap {
         self.exposure
     }
 
-    /// One pixel as 8-bit sRGB.
+    /// One pixel as 8-bit sRGB. A grey pixel (equal channels: the background, a floor
+    /// under white light, most of a frame) is encoded once, with the same result.
     #[inline]
     pub fn srgb8(&self, c: Rgb) -> [u8; 3] {
         let e = self.exposure;
-        [
-            linear_to_srgb8(c.r * e),
-            linear_to_srgb8(c.g * e),
-            linear_to_srgb8(c.b * e),
-        ]
+        let r = linear_to_srgb8(c.r * e);
+        if c.g == c.r && c.b == c.r {
+            return [r; 3];
+        }
+        [r, linear_to_srgb8(c.g * e), linear_to_srgb8(c.b * e)]
     }
 }
 
@@ -158,6 +159,17 @@ mod tests {
             }
         }
         assert_eq!(BUCKET_FLOOR.to_bits() >> BUCKET_SHIFT, FIRST_EXPONENT << 4);
+    }
+
+    #[test]
+    fn a_grey_pixel_encodes_as_its_channels_do() {
+        let tone = ToneMap::new(1.7).unwrap();
+        let each = |c: Rgb| [c.r, c.g, c.b].map(|x| linear_to_srgb8(x * 1.7));
+        for v in [0.0, -0.0, 1e-4, 0.003, 0.3, 0.59, 2.0, f32::NAN] {
+            for c in [Rgb::splat(v), Rgb::new(v, -0.0, v), Rgb::new(v, v, 0.2)] {
+                assert_eq!(tone.srgb8(c), each(c), "{c:?}");
+            }
+        }
     }
 
     #[test]

@@ -50,6 +50,14 @@ impl PixelEstimate {
     }
 }
 
+/// The pixel's value alone (what a display draws).
+impl From<PixelEstimate> for Rgb {
+    #[inline]
+    fn from(p: PixelEstimate) -> Rgb {
+        p.radiance
+    }
+}
+
 impl SplatTarget for PixelEstimate {
     #[inline]
     fn add_splat(&mut self, s: &Splat) {

@@ -325,20 +325,22 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             };
             out.mix(index as u32 | b.depth << 16);
             let object = &self.scene.objects()[index];
-            let (local, mut first, mut second) = self.scatter(&b, &hit, object, count, &mut out);
+            let (local, first, second) = self.scatter(&b, &hit, object, count, &mut out);
             out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
             let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
-            if sum(&second) > sum(&first) {
-                core::mem::swap(&mut first, &mut second);
-            }
-            next = first;
-            if let Some(s) = second {
+            let (heavier, lighter) = if sum(&second) > sum(&first) {
+                (second, first)
+            } else {
+                (first, second)
+            };
+            if let Some(s) = lighter {
                 if stack.push(s).is_err() {
                     debug_assert!(false, "path stack overflow: DEPTH < max_depth");
                 }
             }
+            next = heavier;
         }
         out
     }
@@ -444,13 +446,19 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
                 let turn = Turn::at(b, hit, object, facing);
-                let w = b.weight * c.reflectivity;
-                let reflected = traced(w).then(|| branch(r, w, turn.reflect()));
-                let w = b.weight * c.transparency;
-                let refracted = traced(w).then(|| match interface(d, facing, eta).refracted {
-                    Some(t) => branch(t, w, turn.refract(t, eta)),
-                    None => branch(r, w, turn.reflect()),
-                });
+                let (wr, wt) = (b.weight * c.reflectivity, b.weight * c.transparency);
+                // Under total internal reflection the transmitted part follows the
+                // reflected ray: one ray carries both.
+                let (reflected, refracted) = match interface(d, facing, eta).refracted {
+                    Some(t) => (
+                        traced(wr).then(|| branch(r, wr, turn.reflect())),
+                        traced(wt).then(|| branch(t, wt, turn.refract(t, eta))),
+                    ),
+                    None => {
+                        let w = wr + wt;
+                        (traced(w).then(|| branch(r, w, turn.reflect())), None)
+                    }
+                };
                 (b.weight * local, reflected, refracted)
             }
             // A specular surface after max_depth interactions contributes nothing.

@@ -3,28 +3,34 @@
 //! and its byte stream through the library's own `Rgb565Stream`.
 
 use caustic::budget::{
-    DeviceBudget, DeviceMap, FIG6, FIG6_LIGHTS, FIG6_OBJECTS, GLASS, GLASS_LIGHTS, GLASS_OBJECTS,
+    DeviceBudget, DeviceMap, ErrorFigure, FIG6, FIG6_LIGHTS, FIG6_OBJECTS, GLASS, GLASS_LIGHTS,
+    GLASS_OBJECTS,
 };
 use caustic::demo;
 use caustic::math::Rgb;
 use caustic::photon::ForwardStats;
 use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
-use caustic::render::Renderer;
+use caustic::render::{ErrorTally, PixelEstimate, Renderer, RowPixel};
 use caustic::scene::Scene;
 
 /// What a device streams for one scene: its bytes (little-endian RGB565, row-major),
-/// their FNV-1a, the forward pass's statistics, and the rows in the order they came.
+/// their FNV-1a, the render's error estimate as the firmware prints it (`rel_rmse=…
+/// rel_rmse_caustic=…`, `caustic::budget::ErrorFigure`), the forward pass's
+/// statistics, and the rows in the order they came.
 pub struct Streamed {
     pub bytes: Vec<u8>,
     pub hash: u32,
+    pub error: String,
     pub forward: ForwardStats,
     pub rows: Vec<u32>,
 }
 
 /// The firmware's render of `scene` with `budget` (whose capacities are the const
-/// parameters: objects, lights, stored photons, splats, width, K, depth), calling
-/// `sink(y, row)` for each row in order.
+/// parameters: objects, lights, stored photons, splats, width, K, depth) into rows of
+/// `T` (radiance, or pixels with their error estimates), calling `sink(y, row)` for
+/// each row in order.
 pub fn rows<
+    T: RowPixel + Copy + Default,
     const O: usize,
     const L: usize,
     const N: usize,
@@ -35,7 +41,7 @@ pub fn rows<
 >(
     budget: &DeviceBudget,
     scene: &Scene<O, L>,
-    mut sink: impl FnMut(u32, &[Rgb]),
+    mut sink: impl FnMut(u32, &[T]),
 ) -> ForwardStats {
     let settings = budget.settings().unwrap();
     let mut map: Box<DeviceMap<N, S>> = Box::default();
@@ -43,7 +49,7 @@ pub fn rows<
     let store = map.store::<K>(&settings).unwrap();
     let renderer: Renderer<_, O, L, D> =
         map.with_splats(Renderer::new(scene, &store, settings.max_depth()).unwrap());
-    let mut row = [Rgb::ZERO; W];
+    let mut row = [T::default(); W];
     renderer
         .rows(&mut row, |y, pixels| {
             sink(y, pixels);
@@ -54,7 +60,9 @@ pub fn rows<
 }
 
 /// The firmware's byte stream for `scene`, as the firmware makes it: `DisplaySink`
-/// (default tone map, no dither) onto an `Rgb565Stream`.
+/// (default tone map, no dither) onto an `Rgb565Stream`, with the error estimate the
+/// firmware built with `--features error-estimate` prints (its rows are
+/// `PixelEstimate`s; their radiance, and so the bytes, are the same either way).
 pub fn stream<
     const O: usize,
     const L: usize,
@@ -74,10 +82,12 @@ pub fn stream<
         Ok::<_, ()>(())
     })
     .unwrap();
+    let mut tally = ErrorTally::default();
     let forward = {
         let mut sink = DisplaySink::new(&mut stream, ToneMap::default(), Dither::Off);
-        rows::<O, L, N, S, W, K, D>(budget, scene, |y, pixels| {
+        rows::<PixelEstimate, O, L, N, S, W, K, D>(budget, scene, |y, pixels| {
             order.push(y);
+            tally.add_row(pixels);
             sink.draw_row(y, pixels).unwrap();
         })
     };
@@ -87,6 +97,7 @@ pub fn stream<
     Streamed {
         bytes,
         hash,
+        error: ErrorFigure(tally).to_string(),
         forward,
         rows: order,
     }
@@ -96,6 +107,7 @@ pub fn stream<
 pub fn fig6_rows(sink: impl FnMut(u32, &[Rgb])) -> ForwardStats {
     let scene = demo::fig6(FIG6.width, FIG6.height).unwrap();
     rows::<
+        Rgb,
         FIG6_OBJECTS,
         FIG6_LIGHTS,
         { FIG6.stored },

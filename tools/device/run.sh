@@ -7,15 +7,17 @@
 #       cortex-m3   thumbv7m-none-eabi         qemu-system-arm     -machine mps2-an385 (soft float)
 #       cortex-m33  thumbv8m.main-none-eabihf  qemu-system-arm     -machine mps2-an505 (Armv8-M)
 #       rv32imac    riscv32imac-unknown-none-elf qemu-system-riscv32 -machine virt  (soft float)
-#     twice: for Fig. 6, and with --features glass for the physical scene (NAME-glass);
+#     twice: for Fig. 6, and with --features glass,error-estimate for the physical scene
+#     (NAME-glass; it also prints the render's estimate of its own error);
 #     and the QEMU plugin insn_plugin.so (counts instructions; any guest architecture);
 #  3. runs each under QEMU (semihosting, 300 s time-out): it renders its scene at 160x120
 #     row by row into OUT/NAME.rgb565 (RGB565, little-endian) and prints a PASS line with
 #     the FNV-1a of those bytes;
 #  4. converts the Cortex-M4F images to OUT/fig6.png and OUT/glass.png;
-#  5. runs the host test tests/device.rs against the Cortex-M4F firmwares' bytes and
-#     hashes (host == device bit for bit, and both == the committed hashes); the other
-#     firmwares' files must equal those byte for byte;
+#  5. runs the host test tests/device.rs against the Cortex-M4F firmwares' bytes,
+#     hashes and printed error estimates (host == device bit for bit and digit for
+#     digit, and both == the committed values); the other firmwares' files and
+#     estimates must equal those byte for byte;
 #  6. prints each firmware's budget (budget.sh) and the Cortex-M4F instruction profile;
 #  7. ends with one JSON line per firmware:
 #     {"firmware","target","flash_bytes","static_ram_bytes","stack_bytes","photon_bytes",
@@ -108,7 +110,7 @@ for f in "${firmwares[@]}"; do
     IFS='|' read -r name target qemu machine scene <<<"$f"
     step "$name: building for $target (release, scene $scene)"
     features=()
-    [[ $scene == glass ]] && features=(--features glass)
+    [[ $scene == glass ]] && features=(--features glass,error-estimate)
     (cd "$fw" && CARGO_TARGET_DIR="$fw/target" cargo build --release --target "$target" "${features[@]}")
     # The next build of this target overwrites the ELF: keep this one under its name.
     elf="$out/$name.elf"
@@ -160,6 +162,12 @@ for s in "${scenes[@]}"; do
     tag=$(tr '[:lower:]' '[:upper:]' <<<"$s")
     fnv=$(sed -n 's/^PASS fnv1a=\(0x[0-9a-f]*\).*/\1/p' "$out/$first.log")
     envs+=("CAUSTIC_DEVICE_${tag}_RGB565=$out/$first.rgb565" "CAUSTIC_DEVICE_${tag}_FNV1A=$fnv")
+    error=$(sed -n 's/^error_estimate //p' "$out/$first.log")
+    if [[ -n "$error" ]]; then
+        envs+=("CAUSTIC_DEVICE_${tag}_ERROR=$error")
+    elif [[ $s == glass ]]; then
+        echo "run.sh: $first printed no error_estimate line" >&2; exit 1
+    fi
 done
 (cd "$root" && env "${envs[@]}" cargo test --test device -- --nocapture --test-threads 1) 2>&1 \
     | tee "$out/host-test.log"
@@ -167,6 +175,10 @@ for s in "${scenes[@]}"; do
     tag=$(tr '[:lower:]' '[:upper:]' <<<"$s")
     grep -q "^$tag: device file .* is bit-identical to the host render" "$out/host-test.log" \
         || { echo "run.sh: the host test did not compare the device's $s bytes" >&2; exit 1; }
+    if [[ $s == glass ]]; then
+        grep -q "^$tag: the device's error estimate is the host's" "$out/host-test.log" \
+            || { echo "run.sh: the host test did not compare the device's $s error estimate" >&2; exit 1; }
+    fi
 done
 photon_bytes=$(sed -n 's/.*size_of Photon: \([0-9]*\) bytes$/\1/p' "$out/host-test.log")
 
@@ -177,13 +189,15 @@ for f in "${firmwares[@]}"; do
     elf="$out/$name.elf"
     first=$(first_of "$scene")
     identical=false
-    cmp -s "$out/$name.rgb565" "$out/$first.rgb565" && identical=true
+    cmp -s "$out/$name.rgb565" "$out/$first.rgb565" \
+        && [[ "$(grep '^error_estimate' "$out/$name.log")" == "$(grep '^error_estimate' "$out/$first.log")" ]] \
+        && identical=true
     step "$name: budget"
     "$root/tools/device/budget.sh" "$elf" "$out/$name.log" "$out/$name.insn.txt" | tee "$out/$name.budget.txt"
     eval "$(sed -n 's/^json_\([a-z_]*\)=\([0-9]*\)$/\1=\2/p' "$out/$name.budget.txt")"
     lines+=("$(printf '{"firmware": "%s", "target": "%s", "flash_bytes": %d, "static_ram_bytes": %d, "stack_bytes": %d, "photon_bytes": %d, "forward_instructions": %d, "render_instructions": %d, "bit_identical": %s}' \
         "$name" "$target" "$flash" "$ram" "$stack" "$photon_bytes" "$photons" "$render" "$identical")")
-    [[ "$identical" == true ]] || { echo "run.sh: $name's image differs from $first's" >&2; printf '%s\n' "${lines[@]}"; exit 1; }
+    [[ "$identical" == true ]] || { echo "run.sh: $name's image or error estimate differs from $first's" >&2; printf '%s\n' "${lines[@]}"; exit 1; }
 done
 first="${firmwares[0]%%|*}"
 step "$first: instruction profile (tools/device/profile.py)"

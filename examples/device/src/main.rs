@@ -12,8 +12,12 @@
 //! `caustic::raster::Rgb565Stream` whose bytes (little-endian RGB565, row-major) are
 //! appended to a file on the host by semihosting. No frame buffer exists on the device.
 //!
-//! Output (semihosting stdout): the photon and ray counts, the stack's high-water mark,
-//! and `PASS fnv1a=0x…`, the FNV-1a of the RGB565 bytes. QEMU exits with 0 on success
+//! Output (semihosting stdout): the photon and ray counts, with `--features
+//! error-estimate` the render's estimate of its own error (`error_estimate rel_rmse=…
+//! rel_rmse_caustic=…`: the rows are `caustic::render::PixelEstimate`s, tallied as the
+//! desktop tallies them, printed by `caustic::budget::ErrorFigure` with integer
+//! arithmetic), the stack's high-water mark, and `PASS fnv1a=0x…`, the FNV-1a of the
+//! RGB565 bytes. QEMU exits with 0 on success
 //! and 1 on any failure, panic or fault. The output path is the second word of the
 //! semihosting command line (`arg=caustic,arg=PATH`), else `fig6.rgb565` (`glass.rgb565`).
 //!
@@ -38,9 +42,9 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use caustic::budget::DeviceMap;
-use caustic::math::Rgb;
 use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
 use caustic::render::Renderer;
+use estimate::{Pixel, Tally};
 use semihosting::HostFile;
 
 /// The scene: Fig. 6 by default; `--features glass` builds the physical scene.
@@ -66,11 +70,71 @@ const TARGET: &str = env!("CAUSTIC_FIRMWARE_TARGET");
 /// Row length, pixels.
 const WIDTH: usize = BUDGET.width as usize;
 
+/// The render's estimate of its own error (`--features error-estimate`): rows of
+/// `PixelEstimate`s (radiance, caustic part, error terms) tallied row by row. It costs
+/// Fig. 6 on the Cortex-M4F about 5 KiB of flash (soft-float `f64` sums and ratio,
+/// digits) and 2 M instructions, more than its budget leaves: the glass firmwares carry
+/// it (tools/device/run.sh).
+#[cfg(feature = "error-estimate")]
+mod estimate {
+    use crate::hprintln;
+    use caustic::budget::ErrorFigure;
+    use caustic::math::Rgb;
+    use caustic::render::{ErrorTally, PixelEstimate};
+
+    /// A row's pixel: radiance with its caustic part and error terms.
+    pub type Pixel = PixelEstimate;
+    /// The pixel a row starts as.
+    pub const BLANK: Pixel = PixelEstimate {
+        radiance: Rgb::ZERO,
+        caustic: Rgb::ZERO,
+        split: Rgb::ZERO,
+        sampling2: Rgb::ZERO,
+    };
+
+    /// The tally of every finished row.
+    #[derive(Default)]
+    pub struct Tally(ErrorTally);
+
+    impl Tally {
+        /// Adds a finished row (splats included).
+        pub fn add(&mut self, row: &[Pixel]) {
+            self.0.add_row(row);
+        }
+
+        /// Prints the estimate, as the host test prints it.
+        pub fn report(&self) {
+            hprintln!("error_estimate {}", ErrorFigure(self.0));
+        }
+    }
+}
+/// Without the error estimate: rows of radiance, nothing tallied.
+#[cfg(not(feature = "error-estimate"))]
+mod estimate {
+    use caustic::math::Rgb;
+
+    /// A row's pixel: linear radiance.
+    pub type Pixel = Rgb;
+    /// The pixel a row starts as.
+    pub const BLANK: Pixel = Rgb::ZERO;
+
+    /// Nothing to tally.
+    #[derive(Default)]
+    pub struct Tally;
+
+    impl Tally {
+        /// Nothing to add.
+        pub fn add(&mut self, _: &[Pixel]) {}
+        /// Nothing to print.
+        pub fn report(&self) {}
+    }
+}
+
 /// What the render keeps outside the stack: the photon map (in `.bss`, counted by
-/// the linker), the row of linear radiance, and the output path.
+/// the linker), the row of pixels, and the output path.
 struct Statics {
     map: DeviceMap<{ BUDGET.stored }, { BUDGET.splats }>,
-    row: [Rgb; WIDTH],
+    row: [Pixel; WIDTH],
     path: [u8; 256],
 }
 
@@ -83,7 +147,7 @@ unsafe impl Sync for StaticsCell {}
 
 static STATICS: StaticsCell = StaticsCell(UnsafeCell::new(Statics {
     map: DeviceMap::new(),
-    row: [Rgb::ZERO; WIDTH],
+    row: [estimate::BLANK; WIDTH],
     path: [0; 256],
 }));
 static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -140,23 +204,40 @@ marker!(caustic_mark_photons_end, 2u32);
 marker!(caustic_mark_render_begin, 3u32);
 marker!(caustic_mark_render_end, 4u32);
 
+/// A count for printing, as `u32`: formatting a `u64` links a 64-bit division
+/// (1.1 KiB of flash). A device render's counts stay far below 2³² (the ray budget
+/// bounds a pixel's rays); a larger one would print as `u32::MAX`, never wrapped.
+fn count(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+// The seed is printed as a `u32` (see `count`).
+const _: () = assert!(BUDGET.seed <= u32::MAX as u64);
+
 /// Stops with a failure. The core's `Error` is not formatted: its `Display` prints
 /// `f32` fields, and float formatting alone is about 16 KiB of flash. The host test
 /// (`tests/device.rs`) runs the same code and shows the error's text.
 fn fail(what: &str) -> ! {
-    hprintln!("FAIL {}", what);
+    say(&["FAIL ", what, "\n"]);
     semihosting::exit(false)
+}
+
+/// Writes `parts` to the console as they are: strings go out without `{}`, whose
+/// `Display for str` (padding and precision) is 640 B of flash.
+fn say(parts: &[&str]) {
+    use core::fmt::Write as _;
+    for p in parts {
+        let _ = semihosting::Console.write_str(p);
+    }
 }
 
 /// The whole run; called by the platform's reset code.
 pub fn run() -> ! {
+    say(&["caustic on ", TARGET, ": ", scene::NAME, ", "]);
     hprintln!(
-        "caustic on {}: {}, {}x{}, seed {}",
-        TARGET,
-        scene::NAME,
+        "{}x{}, seed {}",
         BUDGET.width,
         BUDGET.height,
-        BUDGET.seed
+        BUDGET.seed as u32
     );
     let Statics { map, row, path } = take_statics().unwrap_or_else(|| fail("statics taken twice"));
     let path = semihosting::output_path(path, scene::FILE);
@@ -171,7 +252,7 @@ pub fn run() -> ! {
     let forward = forward.unwrap_or_else(|_| fail("forward pass: over budget"));
     hprintln!(
         "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
-        forward.emitted,
+        count(forward.emitted),
         forward.stored,
         BUDGET.stored,
         map.splats().len(),
@@ -189,10 +270,14 @@ pub fn run() -> ! {
         Rgb565Stream::<_, WIDTH>::new(BUDGET.width, BUDGET.height, |b: &[u8]| file.write(b))
             .unwrap_or_else(|_| fail("display"));
 
+    let mut tally = Tally::default();
     caustic_mark_render_begin();
     let rays = {
         let mut sink = DisplaySink::new(&mut stream, ToneMap::default(), Dither::Off);
-        renderer.rows(row, |y, pixels| sink.draw_row(y, pixels))
+        renderer.rows(row, |y, pixels| {
+            tally.add(pixels);
+            sink.draw_row(y, pixels)
+        })
     };
     caustic_mark_render_end();
     let rays = rays.unwrap_or_else(|_| fail("writing the image"));
@@ -200,7 +285,12 @@ pub fn run() -> ! {
     let (pixels, hash, complete) = (stream.pixels(), stream.hash(), stream.is_complete());
     let _ = stream.into_writer(); // gives `file` back
     file.close().unwrap_or_else(|e| fail(e));
-    hprintln!("rays: {} eye, {} shadow", rays.eye, rays.shadow);
+    hprintln!(
+        "rays: {} eye, {} shadow",
+        count(rays.eye),
+        count(rays.shadow)
+    );
+    tally.report();
     let (stack, reserved) = stack_high_water();
     hprintln!(
         "stack high-water: {} bytes (of {} reserved)",
@@ -222,7 +312,10 @@ pub fn run() -> ! {
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     match info.location() {
-        Some(l) => hprintln!("PANIC at {}:{}", l.file(), l.line()),
+        Some(l) => {
+            say(&["PANIC at ", l.file(), ":"]);
+            hprintln!("{}", l.line())
+        }
         None => hprintln!("PANIC"),
     }
     semihosting::exit(false)
