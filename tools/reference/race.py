@@ -267,6 +267,8 @@ def main(argv):
     ap.add_argument("--binary", default=os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(C.REPO, "target")),
                                                      "release", "caustic"))
     args = ap.parse_args(argv)
+    if args.extra_spp < 128:
+        ap.error("--extra-spp: at least 128 (two halves of 64-spp passes)")
     load0 = os.getloadavg()[0]
     js, ref, region = reference()
     ref_noise = reference_noise(ref, region, args.ref_seeds)
