@@ -11,8 +11,8 @@ reference luminance) is measured against the committed pixel-area reference
 log-log between the two budgets around it. Budgets double until the error is below 5 %;
 ptracer's also stop before their total time would pass --max-seconds (150), and its time to
 5 % is then extrapolated along its measured convergence (log-log least squares of error against
-spp over its last three runs; an unbiased light tracer converges as spp^-1/2), at its last
-run's seconds per spp.
+spp over its last three runs; an unbiased light tracer converges as spp^-1/2), at those
+runs' seconds per spp.
 
 Matching transport: ptracer also computes floor light that the glass refocuses onto the floor
 (L D S+ D E and deeper), which the contract leaves out (tools/reference/README.md). That part
@@ -194,8 +194,8 @@ def race_ptracer(js, target, region, noise, max_spp, max_seconds):
 def time_to(rows, target=TARGET):
     """Seconds to reach `target`: log-log between the two runs around it; else extrapolated
     along the least-squares line of log error against log budget over the last three runs
-    (the convergence rate, measured on budgets, which timing noise does not disturb), at the
-    last run's seconds per unit of budget (then marked, with the rate)."""
+    (the convergence rate, measured on budgets, which timing noise does not disturb), at
+    those runs' seconds per unit of budget (then marked, with the rate)."""
     pts = [(math.log(r["seconds"]), math.log(r["true"])) for r in rows if r["true"] > 0]
     lt = math.log(target)
     for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
@@ -207,9 +207,10 @@ def time_to(rows, target=TARGET):
     if slope >= 0:
         return float("nan"), " (not reached, not decreasing)"
     budget = math.exp(mn + (lt - me) / slope)
-    per_unit = rows[-1]["seconds"] / rows[-1]["n"]
+    timed = rows[-3:]
+    per_unit = sum(r["seconds"] for r in timed) / sum(r["n"] for r in timed)
     return budget * per_unit, (f" (extrapolated: error ∝ budget^{slope:.2f} over the last 3 runs, "
-                               f"{budget:.0f} at {per_unit * 1000:.1f} ms each)")
+                               f"{budget:.0f} at their mean {per_unit * 1000:.1f} ms each)")
 
 
 def write_md(path, args, cau, pt, info, ref_noise, region, load):
