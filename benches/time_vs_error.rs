@@ -1,76 +1,63 @@
-//! Run time against error: how far each photon budget is from the reference, and how
-//! long it takes.
+//! Run time against error: how far each budget of the default estimator is from the
+//! reference, and how long it takes.
 //!
-//! `cargo bench --bench time_vs_error` renders every scene that has a reference image in
-//! `tests/data/` at the reference's size, sweeping the photon budget, `k`, and the number
-//! of progressive passes; records the median wall time of a few repeats (all threads)
-//! and the relative RMSE against the reference over the full image and inside the
-//! caustic region (pixels where the reference's caustic part exceeds 2% of its
-//! 99.9th percentile), per pixel and 2×2-binned. It writes
-//! `target/time_vs_error/time_vs_error.csv` and a log–log plot of caustic-region error
-//! against time with each scene's Pareto front, `time_vs_error.svg` (PNG with
-//! `rsvg-convert`). Rows of `docs/reference_baseline.csv` (the reference tool's own light
-//! tracer at small budgets, made by `tools/reference/baseline.sh`) are plotted as a
-//! baseline curve.
+//! `cargo bench --bench time_vs_error` renders every scene that has a reference in
+//! `tests/data/` (the three the defaults were tuned on and the three held-out ones) at
+//! the reference's size (320×240) with the default estimator and a plain photons block
+//! (`k` 64, `max_radius` 0.25, the file's `max_depth`): one pass at photon budgets from
+//! 25k to 3.2M per light, and progressive passes of 100k. It records the median wall
+//! time of three repeats (all threads; the render only, no file I/O) and the relative
+//! RMSE `√mean((a−b)²)/mean(b)` against the reference over the full image and over the
+//! caustic region (the reference's caustic part at least 10% of its luminance, Rec. 709:
+//! the README's definition). It writes `target/time_vs_error/time_vs_error.csv` and a
+//! log–log plot of the caustic region's error against time, one panel per scene, with
+//! the reference's own noise there (`NAME.ref.json`: the committed mean of two seeds has
+//! half their difference) as a dashed floor: `time_vs_error.svg`.
 //!
-//! `CAUSTIC_BENCH_QUICK=1` runs a reduced sweep; `CAUSTIC_BENCH_OUT=DIR` moves the output.
+//! `CAUSTIC_BENCH_QUICK=1` runs a reduced sweep (one repeat, fewer budgets);
+//! `CAUSTIC_BENCH_OUT=DIR` moves the output.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use caustic::desktop::image::{compare, mask_above, Image};
-use caustic::desktop::run::render_illumination;
+use caustic::desktop::image::{compare, Image};
 use caustic::desktop::{parse_scene, render, RenderOptions};
 use caustic::photon::PhotonSettings;
 use plotters::prelude::*;
 
-/// One configuration of the sweep.
-#[derive(Clone, Copy, Debug)]
-struct Config {
-    photons: u32,
-    k: u32,
-    passes: u32,
-    supersample: u32,
-    estimator: Estimator,
-    /// Part of the progressive series (radius from `PROGRESSIVE_R1`, even at one pass).
-    series_progressive: bool,
-}
-
-/// How the caustic light is estimated.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Estimator {
-    /// The k nearest photons within [`NEAREST_RADIUS`].
-    Nearest,
-    /// Every photon within a fixed radius: [`FIXED_RADIUS`] for single passes (the
-    /// reference's own kernel, so that what remains is noise and transport, not the
-    /// choice of kernel at a caustic's fold); progressive passes start at
-    /// [`PROGRESSIVE_R1`] and shrink as `r_i² = r_1²·i^(α−1)`.
-    FixedRadius,
-    /// Illumination maps with texels of side [`TEXEL`].
-    IlluminationMap,
-}
-
-/// The k-nearest estimate's radius bound, scene units (a tenth of the spheres' radius).
-const NEAREST_RADIUS: f32 = 0.1;
-/// The single-pass fixed radius: the reference's kernel radius.
-const FIXED_RADIUS: f32 = 0.015;
-/// The first radius of the progressive passes.
-const PROGRESSIVE_R1: f32 = 0.02;
-/// The illumination maps' texel side.
-const TEXEL: f32 = 0.02;
+/// The scenes: reference name, scene file, role.
+const SCENES: [(&str, &str, &str); 6] = [
+    ("glass_sphere", "scenes/glass_sphere.json", "tuning"),
+    ("two_balls", "scenes/two_balls.json", "tuning"),
+    ("tube", "scenes/tube.json", "tuning"),
+    ("sphere_wall", "scenes/heldout/sphere_wall.json", "held out"),
+    ("tilted_cube", "scenes/heldout/tilted_cube.json", "held out"),
+    (
+        "balls_mirror_tube",
+        "scenes/heldout/balls_mirror_tube.json",
+        "held out",
+    ),
+];
 
 /// One measured point.
 #[derive(Clone, Debug)]
 struct Point {
     scene: String,
-    series: String,
-    config: Config,
+    series: &'static str,
+    photons: u32,
+    passes: u32,
     seconds: f64,
     full: f64,
     caustic: f64,
-    full_bin2: f64,
-    caustic_bin2: f64,
+}
+
+/// One scene's reference: full image, caustic-region mask, and the reference's own noise
+/// in the caustic region.
+struct Reference {
+    image: Image,
+    region: Vec<bool>,
+    noise_caustic: f64,
 }
 
 fn root() -> PathBuf {
@@ -82,291 +69,175 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// The sweep: single passes over photon budgets for each estimator and k, then
-/// progressive passes.
-fn configs(quick: bool, supersample: u32) -> Vec<(String, Config)> {
-    let mut out = Vec::new();
-    let mut add = |series: String, photons: u32, k: u32, passes: u32, estimator: Estimator| {
-        let series_progressive = series.starts_with("progressive");
-        let c = Config {
-            photons,
-            k,
-            passes,
-            supersample,
-            estimator,
-            series_progressive,
-        };
-        out.push((series, c));
-    };
+/// The sweep: (series, photons per light per pass, passes).
+fn configs(quick: bool) -> Vec<(&'static str, u32, u32)> {
     let budgets: &[u32] = if quick {
-        &[10_000, 100_000]
+        &[25_000, 400_000]
     } else {
-        &[10_000, 30_000, 100_000, 300_000, 1_000_000]
+        &[
+            25_000, 50_000, 100_000, 200_000, 400_000, 800_000, 1_600_000, 3_200_000,
+        ]
     };
-    let ks: &[u32] = if quick { &[64] } else { &[16, 64, 256] };
-    for &k in ks {
-        for &photons in budgets {
-            add(format!("kd-tree k={k}"), photons, k, 1, Estimator::Nearest);
-        }
-    }
-    let budgets: &[u32] = if quick {
-        &[100_000]
-    } else {
-        &[30_000, 100_000, 300_000, 500_000, 1_000_000, 3_000_000]
-    };
-    for &photons in budgets {
-        add(
-            "kd-tree fixed r=0.015".into(),
-            photons,
-            64,
-            1,
-            Estimator::FixedRadius,
-        );
-    }
-    let budgets: &[u32] = if quick {
-        &[100_000]
-    } else {
-        &[10_000, 30_000, 100_000, 300_000, 1_000_000]
-    };
-    for &photons in budgets {
-        add(
-            "illumination maps".into(),
-            photons,
-            64,
-            1,
-            Estimator::IlluminationMap,
-        );
-    }
-    let passes: &[u32] = if quick {
-        &[1, 4]
-    } else {
-        &[1, 2, 4, 8, 16, 32]
-    };
-    for &p in passes {
-        add(
-            "progressive 100k/pass".into(),
-            100_000,
-            64,
-            p,
-            Estimator::FixedRadius,
-        );
-    }
+    let passes: &[u32] = if quick { &[2] } else { &[2, 4, 8, 16] };
+    let mut out: Vec<_> = budgets.iter().map(|&n| ("one pass", n, 1)).collect();
+    out.extend(passes.iter().map(|&p| ("passes of 100k", 100_000, p)));
     out
 }
 
-fn measure(
-    name: &str,
-    reference: &str,
-    supersample: u32,
-    quick: bool,
-    repeats: usize,
-) -> Vec<Point> {
-    let text = std::fs::read_to_string(root().join(format!("scenes/{name}.json"))).unwrap();
+fn reference(name: &str) -> Reference {
+    let read = |suffix: &str| {
+        Image::read_pfm(&root().join(format!("tests/data/{name}.{suffix}.pfm"))).unwrap()
+    };
+    let (image, caustic) = (read("ref"), read("ref.caustic"));
+    let region = image
+        .pixels
+        .iter()
+        .zip(&caustic.pixels)
+        .map(|(f, c)| f.luminance() > 0.0 && c.luminance() >= 0.1 * f.luminance())
+        .collect();
+    let json = std::fs::read_to_string(root().join(format!("tests/data/{name}.ref.json")))
+        .unwrap()
+        .parse::<serde_json::Value>()
+        .unwrap();
+    let noise_caustic = json["noise"]["mean_of_seeds_rel_rmse_caustic_region"]
+        .as_f64()
+        .unwrap();
+    Reference {
+        image,
+        region,
+        noise_caustic,
+    }
+}
+
+fn measure(name: &str, path: &str, r: &Reference, quick: bool) -> Vec<Point> {
+    let text = std::fs::read_to_string(root().join(path)).unwrap();
     let loaded = parse_scene(&text).unwrap();
-    let reference_img =
-        Image::read_pfm(&root().join(format!("tests/data/{reference}.ref.pfm"))).unwrap();
-    let caustic_part =
-        Image::read_pfm(&root().join(format!("tests/data/{reference}.ref.caustic.pfm"))).unwrap();
-    let mask = mask_above(&caustic_part, 0.02);
-    let mask2 = mask_above(&caustic_part.binned(2), 0.02);
-    let ref2 = reference_img.binned(2);
     let mut scene = loaded.scene;
     scene.set_camera(
         scene
             .camera()
-            .with_size(reference_img.width, reference_img.height)
+            .with_size(r.image.width, r.image.height)
             .unwrap(),
     );
-    let p = loaded.photons;
+    let repeats = if quick { 1 } else { 3 };
     let mut points = Vec::new();
-    for (series, c) in configs(quick, supersample) {
-        let radius = match c.estimator {
-            Estimator::Nearest => NEAREST_RADIUS,
-            Estimator::FixedRadius if c.passes > 1 || c.series_progressive => PROGRESSIVE_R1,
-            Estimator::FixedRadius => FIXED_RADIUS,
-            Estimator::IlluminationMap => TEXEL,
-        };
-        let settings = PhotonSettings::new(c.photons, c.k, radius, p.max_depth())
-            .unwrap()
-            .with_fixed_radius(c.estimator == Estimator::FixedRadius);
+    for (series, photons, passes) in configs(quick) {
+        let settings = PhotonSettings::new(photons, 64, 0.25, loaded.photons.max_depth()).unwrap();
         let opts = RenderOptions {
-            passes: c.passes,
-            sampling: caustic::render::Sampling::Grid(c.supersample),
+            passes,
             ..RenderOptions::default()
         };
         let mut times = Vec::new();
         let mut image = None;
         for _ in 0..repeats {
             let t = Instant::now();
-            let result = match c.estimator {
-                Estimator::IlluminationMap => {
-                    render_illumination(&scene, &settings, &opts, TEXEL).map(|r| r.0.image)
-                }
-                _ => render(&scene, &settings, &opts).map(|r| r.0),
-            };
-            match result {
-                Ok(img) => image = Some(img),
-                Err(e) => {
-                    // A budget the store refuses (e.g. too many texels) is a point we
-                    // cannot measure, not a failure of the benchmark.
-                    eprintln!("{name} {series} N={}: skipped: {e}", c.photons);
-                    break;
-                }
-            }
+            image = Some(render(&scene, &settings, &opts).unwrap().0);
             times.push(t.elapsed().as_secs_f64());
         }
-        let Some(img) = image else { continue };
-        let img2 = img.binned(2);
-        let e = |a: &Image, b: &Image, m: Option<&[bool]>| {
-            compare(a, b, m).map_or(f64::NAN, |e| e.rel_rmse)
-        };
+        let img = image.unwrap();
+        let e = |m: Option<&[bool]>| compare(&img, &r.image, m).map_or(f64::NAN, |e| e.rel_rmse);
         let point = Point {
-            scene: if supersample > 1 {
-                format!("{name} ({supersample}×{supersample} spp)")
-            } else {
-                name.into()
-            },
+            scene: name.into(),
             series,
-            config: c,
+            photons,
+            passes,
             seconds: median(times),
-            full: e(&img, &reference_img, None),
-            caustic: e(&img, &reference_img, Some(&mask)),
-            full_bin2: e(&img2, &ref2, None),
-            caustic_bin2: e(&img2, &ref2, Some(&mask2)),
+            full: e(None),
+            caustic: e(Some(&r.region)),
         };
         eprintln!(
-            "{:>28} {:>24} N={:>8} k={:>3} P={:>2}: {:8.3} s  full {:.4}  caustic {:.4}  (2×2: {:.4} / {:.4})",
-            point.scene, point.series, c.photons, c.k, c.passes, point.seconds, point.full, point.caustic, point.full_bin2, point.caustic_bin2
+            "{name:>18} {series:>15} N={photons:>8} P={passes:>2}: {:7.3} s  full {:.4}  caustic {:.4}",
+            point.seconds, point.full, point.caustic
         );
         points.push(point);
     }
     points
 }
 
-/// Points not beaten by any faster point: the best error reachable in a given time.
-fn pareto(points: &[&Point]) -> Vec<(f64, f64)> {
-    let mut v: Vec<(f64, f64)> = points
+/// One panel: the caustic region's error against time for each series of one scene,
+/// and the reference's own noise as a dashed floor.
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    mine: &[&Point],
+    noise: f64,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let (t0, t1) = mine.iter().fold((f64::MAX, 0.0f64), |(a, b), p| {
+        (a.min(p.seconds), b.max(p.seconds))
+    });
+    let (e0, e1) = mine
         .iter()
-        .map(|p| (p.seconds, p.caustic))
-        .filter(|p| p.1.is_finite())
-        .collect();
-    v.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut front: Vec<(f64, f64)> = Vec::new();
-    for p in v {
-        if front.last().is_none_or(|l| p.1 < l.1) {
-            front.push(p);
-        }
-    }
-    front
-}
-
-/// `scene,photons,seconds,full,caustic` rows of the reference tool's own tracer.
-fn baseline() -> Vec<(String, f64, f64)> {
-    let Ok(text) = std::fs::read_to_string(root().join("docs/reference_baseline.csv")) else {
-        return Vec::new();
-    };
-    text.lines()
-        .skip(1)
-        .filter_map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            Some((
-                f.first()?.to_string(),
-                f.get(2)?.parse().ok()?,
-                f.get(4)?.parse().ok()?,
-            ))
-        })
-        .collect()
-}
-
-fn plot(points: &[Point], out: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let mut scenes: Vec<String> = points.iter().map(|p| p.scene.clone()).collect();
-    scenes.dedup();
-    let base = baseline();
-    let root_area = SVGBackend::new(out, (900, 330 * scenes.len() as u32)).into_drawing_area();
-    root_area.fill(&WHITE)?;
-    let panels = root_area.split_evenly((scenes.len(), 1));
-    for (panel, scene) in panels.iter().zip(&scenes) {
-        let mine: Vec<&Point> = points.iter().filter(|p| &p.scene == scene).collect();
-        let theirs: Vec<(f64, f64)> = base
+        .map(|p| p.caustic)
+        .chain([noise])
+        .fold((f64::MAX, 0.0f64), |(a, b), e| (a.min(e), b.max(e)));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(34)
+        .y_label_area_size(52)
+        .build_cartesian_2d(
+            (t0 * 0.7..t1 * 1.4).log_scale(),
+            (e0 * 0.7..e1 * 1.4).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .max_light_lines(0)
+        .x_labels(12)
+        .y_labels(12)
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .x_label_formatter(&|v| format!("{v:.1}"))
+        .x_desc("wall time, s (median of 3)")
+        .y_desc("caustic region rel. RMSE")
+        .draw()?;
+    let mut series: Vec<&str> = mine.iter().map(|p| p.series).collect();
+    series.dedup();
+    for (i, s) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        // In budget order: where the timings are noisy, the line shows it.
+        let pts: Vec<(f64, f64)> = mine
             .iter()
-            .filter(|b| scene.starts_with(&b.0))
-            .map(|b| (b.1, b.2))
+            .filter(|p| p.series == *s)
+            .map(|p| (p.seconds, p.caustic))
             .collect();
-        let all_t = mine
-            .iter()
-            .map(|p| p.seconds)
-            .chain(theirs.iter().map(|b| b.0));
-        let all_e = mine
-            .iter()
-            .map(|p| p.caustic)
-            .chain(theirs.iter().map(|b| b.1))
-            .filter(|e| e.is_finite());
-        let (t0, t1) = all_t.fold((f64::MAX, 0.0f64), |(a, b), t| (a.min(t), b.max(t)));
-        let (e0, e1) = all_e.fold((f64::MAX, 0.0f64), |(a, b), e| (a.min(e), b.max(e)));
-        let mut chart = ChartBuilder::on(panel)
-            .caption(
-                format!("{scene}: caustic-region relative RMSE vs time"),
-                ("sans-serif", 18),
-            )
-            .margin(12)
-            .x_label_area_size(36)
-            .y_label_area_size(56)
-            .build_cartesian_2d(
-                (t0 * 0.7..t1 * 1.4).log_scale(),
-                (e0 * 0.7..e1 * 1.4).log_scale(),
-            )?;
         chart
-            .configure_mesh()
-            .y_label_formatter(&|v| format!("{v:.3}"))
-            .x_label_formatter(&|v| format!("{v:.3}"))
-            .x_desc("wall time, s (median)")
-            .y_desc("relative RMSE")
-            .draw()?;
-        let mut series: Vec<String> = mine.iter().map(|p| p.series.clone()).collect();
-        series.dedup();
-        for (i, s) in series.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
-            let mut pts: Vec<(f64, f64)> = mine
-                .iter()
-                .filter(|p| &p.series == s)
-                .map(|p| (p.seconds, p.caustic))
-                .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
-                .label(s.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
+            .label(*s)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+    }
+    let dashes = (0..12).map(|i| {
+        let a = (t0 * 0.7) * ((t1 * 2.0) / (t0 * 0.7)).powf(i as f64 / 12.0);
+        let b = (t0 * 0.7) * ((t1 * 2.0) / (t0 * 0.7)).powf((i as f64 + 0.5) / 12.0);
+        PathElement::new(vec![(a, noise), (b, noise)], BLACK)
+    });
+    chart
+        .draw_series(dashes)?
+        .label("reference's own noise")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], BLACK));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.85))
+        .draw()?;
+    Ok(())
+}
+
+fn plot(points: &[Point], noises: &[f64], out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let rows = SCENES.len().div_ceil(2);
+    let root_area = SVGBackend::new(out, (1100, 330 * rows as u32)).into_drawing_area();
+    root_area.fill(&WHITE)?;
+    let panels = root_area.split_evenly((rows, 2));
+    for ((area, (name, _, role)), noise) in panels.iter().zip(SCENES).zip(noises) {
+        let mine: Vec<&Point> = points.iter().filter(|p| p.scene == name).collect();
+        if !mine.is_empty() {
+            panel(area, &format!("{name} ({role})"), &mine, *noise)?;
         }
-        if !theirs.is_empty() {
-            let mut pts = theirs.clone();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(pts.clone(), BLACK.stroke_width(2)))?
-                .label("reference light tracer (Mitsuba ray queries)")
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(2))
-                });
-            chart.draw_series(
-                pts.into_iter()
-                    .map(|p| TriangleMarker::new(p, 5, BLACK.filled())),
-            )?;
-        }
-        let front = pareto(&mine);
-        chart
-            .draw_series(LineSeries::new(
-                front,
-                RGBColor(120, 120, 120).stroke_width(1),
-            ))?
-            .label("Pareto front (caustic)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RGBColor(120, 120, 120)));
-        chart
-            .configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()?;
     }
     root_area.present()?;
     Ok(())
@@ -377,68 +248,48 @@ fn main() {
     let out = std::env::var_os("CAUSTIC_BENCH_OUT")
         .map_or_else(|| root().join("target/time_vs_error"), PathBuf::from);
     std::fs::create_dir_all(&out).unwrap();
-    let repeats = if quick { 1 } else { 3 };
     let mut points = Vec::new();
-    for name in ["glass_sphere", "two_balls", "tube"] {
-        if root().join(format!("tests/data/{name}.ref.pfm")).exists() {
-            points.extend(measure(name, name, 1, quick, repeats));
-        }
+    let mut noises = Vec::new();
+    for (name, path, _) in SCENES {
+        let r = reference(name);
+        points.extend(measure(name, path, &r, quick));
+        noises.push(r.noise_caustic);
     }
-    if root().join("tests/data/glass_sphere.ss4.ref.pfm").exists() {
-        points.extend(measure(
-            "glass_sphere",
-            "glass_sphere.ss4",
-            4,
-            quick,
-            repeats,
-        ));
-    }
-    // Series and scene names hold no comma, so the CSV needs no quoting.
-    let mut csv = String::from("scene,series,photons,k,passes,supersample,seconds,full_rel_rmse,caustic_rel_rmse,full_rel_rmse_bin2,caustic_rel_rmse_bin2\n");
+    // Scene and series names hold no comma, so the CSV needs no quoting.
+    let mut csv = String::from(
+        "scene,series,photons,passes,seconds,full_rel_rmse,caustic_rel_rmse,ref_noise_caustic\n",
+    );
     for p in &points {
-        let c = p.config;
+        let noise = SCENES
+            .iter()
+            .position(|s| s.0 == p.scene)
+            .map_or(f64::NAN, |i| noises[i]);
         writeln!(
             csv,
-            "{},{},{},{},{},{},{:.5},{:.6},{:.6},{:.6},{:.6}",
-            p.scene,
-            p.series,
-            c.photons,
-            c.k,
-            c.passes,
-            c.supersample,
-            p.seconds,
-            p.full,
-            p.caustic,
-            p.full_bin2,
-            p.caustic_bin2
+            "{},{},{},{},{:.4},{:.6},{:.6},{:.6}",
+            p.scene, p.series, p.photons, p.passes, p.seconds, p.full, p.caustic, noise
         )
         .unwrap();
     }
     std::fs::write(out.join("time_vs_error.csv"), &csv).unwrap();
-    plot(&points, &out.join("time_vs_error.svg")).unwrap();
-    // Progressive convergence: slope of log MSE against log photons (theory: −2/3).
-    let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
-    scenes.dedup();
-    for scene in scenes {
-        let prog: Vec<(f64, f64)> = points
+    plot(&points, &noises, &out.join("time_vs_error.svg")).unwrap();
+    // Convergence of the single passes: slope of log error against log photons
+    // (N^-1/2 for the unbiased parts, about N^-1/3 for a progressive gather).
+    for (name, _, _) in SCENES {
+        let one: Vec<(f64, f64)> = points
             .iter()
-            .filter(|p| p.scene == scene && p.series.starts_with("progressive"))
-            .map(|p| {
-                (
-                    ((p.config.photons * p.config.passes) as f64).ln(),
-                    (p.caustic_bin2 * p.caustic_bin2).ln(),
-                )
-            })
+            .filter(|p| p.scene == name && p.passes == 1)
+            .map(|p| ((p.photons as f64).ln(), p.caustic.ln()))
             .collect();
-        if prog.len() >= 2 {
-            let n = prog.len() as f64;
+        if one.len() >= 2 {
+            let n = one.len() as f64;
             let (mx, my) = (
-                prog.iter().map(|p| p.0).sum::<f64>() / n,
-                prog.iter().map(|p| p.1).sum::<f64>() / n,
+                one.iter().map(|p| p.0).sum::<f64>() / n,
+                one.iter().map(|p| p.1).sum::<f64>() / n,
             );
-            let slope = prog.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
-                / prog.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-            println!("{scene}: progressive caustic MSE ∝ N^{slope:.2} (2×2-binned; theory −0.67, until the reference's own noise and kernel are reached)");
+            let slope = one.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+                / one.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+            println!("{name}: caustic-region error ∝ N^{slope:.2} over one-pass budgets");
         }
     }
     println!("wrote {}", out.join("time_vs_error.csv").display());

@@ -14,12 +14,17 @@
 //! their luminance. Each scene file's photons block is replaced by a plain one
 //! (`k` 64, `max_radius` 0.25, the k nearest): the estimator must be right without
 //! hints. `glass_sphere` and `two_balls` chose the defaults; `tube` was measured after.
-//! Bounds are about 1.3 times the values measured when they were set, printed by
-//! `cargo test --release --test accuracy -- --nocapture`.
+//! The three scenes are rendered once at 25k, 100k and 400k photons (the sweep) and
+//! every test reads those nine renders. Bounds are about 1.3 times the values measured
+//! when they were set, printed by `cargo test --release --test accuracy -- --nocapture`
+//! (the same figures at 320×240 and for the held-out scenes: `docs/error_calibration.csv`).
 
 use caustic::desktop::image::{compare, Image};
 use caustic::desktop::{parse_scene, render_with_error, RenderOptions, Rendered};
 use caustic::photon::PhotonSettings;
+use std::sync::OnceLock;
+
+mod support;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -47,14 +52,41 @@ fn render(name: &str, count: u32) -> Rendered {
     render_with_error(&scene, &settings, &RenderOptions::default()).unwrap()
 }
 
-/// Relative RMSE of the full image and of the caustic region.
+/// The budgets of the sweep: 16 times from the first to the last.
+const BUDGETS: [u32; 3] = [25_000, 100_000, 400_000];
+/// The scenes of the sweep: `glass_sphere` and `two_balls` chose the defaults, `tube`
+/// was measured after.
+const SCENES: [&str; 3] = ["glass_sphere", "two_balls", "tube"];
+
+/// One render of the sweep against its reference: relative RMSE measured and estimated,
+/// full image and caustic region.
 struct Measured {
+    name: &'static str,
+    count: u32,
     full: f64,
     caustic: f64,
     estimated_full: f64,
+    estimated_caustic: f64,
 }
 
-fn measure(name: &str, count: u32) -> Measured {
+/// The reference's own noise at 160×120 (full image, caustic region): the committed
+/// mean of two seeds has half the seed pair's relative RMSE over 2×2 bins
+/// (`NAME.ref.json`).
+fn reference_noise(name: &str) -> (f64, f64) {
+    let json: serde_json::Value =
+        serde_json::from_str(&support::data_text(&format!("{name}.ref.json"))).unwrap();
+    let pair = |key: &str| {
+        json["noise"][key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{name}: {key}"))
+    };
+    (
+        pair("pair_rel_rmse_full_2x2") / 2.0,
+        pair("pair_rel_rmse_caustic_region_2x2") / 2.0,
+    )
+}
+
+fn measure(name: &'static str, count: u32) -> Measured {
     let (full, caustic) = reference(name);
     let r = render(name, count);
     let region: Vec<bool> = full
@@ -64,46 +96,69 @@ fn measure(name: &str, count: u32) -> Measured {
         .map(|(f, c)| f.luminance() > 0.0 && c.luminance() >= 0.1 * f.luminance())
         .collect();
     let m = Measured {
+        name,
+        count,
         full: compare(&r.image, &full, None).unwrap().rel_rmse,
         caustic: compare(&r.image, &full, Some(&region)).unwrap().rel_rmse,
         estimated_full: r.stats.error.rel_rmse.unwrap(),
+        estimated_caustic: r.stats.error.rel_rmse_caustic.unwrap(),
     };
     println!(
-        "{name:>12} {count:>8} photons: rel. RMSE full {:.4} (estimated {:.4}), caustic region {:.4} ({} px)",
+        "{name:>12} {count:>7} photons: rel. RMSE full {:.4} (estimated {:.4}), caustic region {:.4} (estimated {:.4}, {} px)",
         m.full,
         m.estimated_full,
         m.caustic,
+        m.estimated_caustic,
         region.iter().filter(|&&b| b).count()
     );
     m
 }
 
-/// More photons, less error: 16 times the photons cut the caustic region's error 2.26
-/// times on the glass sphere and 1.56 times on the two balls when these bounds were set
-/// (4 times is the ideal of an unbiased estimate; the reference's own noise, 1–1.3%
+/// Every scene at every budget, rendered once for all the tests here (each render
+/// takes all cores; the tests wait for the first to finish the sweep).
+fn sweep() -> &'static [Measured] {
+    static SWEEP: OnceLock<Vec<Measured>> = OnceLock::new();
+    SWEEP.get_or_init(|| {
+        SCENES
+            .iter()
+            .flat_map(|&name| BUDGETS.iter().map(move |&count| measure(name, count)))
+            .collect()
+    })
+}
+
+fn at(name: &str, count: u32) -> &'static Measured {
+    sweep()
+        .iter()
+        .find(|m| m.name == name && m.count == count)
+        .unwrap()
+}
+
+/// More photons, less error: 16 times the photons cut the caustic region's error 2.46
+/// times on the glass sphere and 2.49 times on the two balls when these bounds were
+/// set (4 times is the ideal of an unbiased estimate; the reference's own noise, 1–1.3%
 /// here after binning, is part of what is left). What keeps the two balls from doing
 /// better is known: behind a ball the floor is magnified, and the gather's footprint,
 /// taken from the pixel's ray cone without the lens's magnification, is wider than the
 /// pixel there (a bias at the focus seen through the glass).
 #[test]
 fn the_caustics_converge_to_the_reference() {
-    for (name, bound, least_gain) in [("glass_sphere", 0.05, 2.0), ("two_balls", 0.075, 1.4)] {
-        let low = measure(name, 50_000);
-        let high = measure(name, 800_000);
+    for (name, bound, least_gain) in [("glass_sphere", 0.06, 2.0), ("two_balls", 0.075, 1.8)] {
+        let low = at(name, BUDGETS[0]);
+        let high = at(name, BUDGETS[2]);
         assert!(high.caustic < bound, "{name}: {}", high.caustic);
         let gain = low.caustic / high.caustic;
         assert!(
             gain > least_gain,
             "{name}: the error fell only {gain:.2} times"
         );
-        assert!(high.full < 0.7 * low.full, "{name}");
+        assert!(high.full < 0.6 * low.full, "{name}");
     }
 }
 
 /// A scene the defaults were not chosen on, at its file's budget.
 #[test]
 fn a_held_out_scene_meets_its_bound() {
-    let m = measure("tube", 100_000);
+    let m = at("tube", 100_000);
     assert!(
         m.full < 0.05 && m.caustic < 0.14,
         "{:.4} {:.4}",
@@ -112,18 +167,36 @@ fn a_held_out_scene_meets_its_bound() {
     );
 }
 
-/// The render's own error estimate is within a factor 2 of the error measured against
-/// the reference, on every scene and budget here.
+/// The render's own error estimate, full image and caustic region, is within a factor 2
+/// of the error measured against the reference, on every scene and budget of the
+/// sweep. The reference is noisy too, independently of the render, so
+/// `E[measured²] = true² + noise²`: its noise is subtracted in quadrature (it is 1–10%
+/// of the measured figures here, at most 0.3% / 1.0% absolute).
 #[test]
 fn the_error_estimate_is_calibrated() {
-    for (name, count) in [("glass_sphere", 100_000), ("tube", 400_000)] {
-        let m = measure(name, count);
-        let ratio = m.estimated_full / m.full;
-        assert!(
-            (0.5..2.0).contains(&ratio),
-            "{name} at {count}: estimated {:.4}, measured {:.4}",
-            m.estimated_full,
-            m.full
-        );
+    let mut worst = (1.0f64, "");
+    for m in sweep() {
+        let (noise_full, noise_caustic) = reference_noise(m.name);
+        for (what, estimated, measured, noise) in [
+            ("full", m.estimated_full, m.full, noise_full),
+            ("caustic", m.estimated_caustic, m.caustic, noise_caustic),
+        ] {
+            let truth = (measured * measured - noise * noise).max(0.0).sqrt();
+            let ratio = estimated / truth;
+            println!(
+                "{:>12} {:>7} {what:>7}: estimated {estimated:.4}, true {truth:.4} (measured {measured:.4}), ratio {ratio:.2}",
+                m.name, m.count
+            );
+            assert!(
+                (0.5..2.0).contains(&ratio),
+                "{} at {} photons, {what}: estimated {estimated:.4}, true {truth:.4}",
+                m.name,
+                m.count
+            );
+            if ratio.ln().abs() > worst.0.ln().abs() {
+                worst = (ratio, m.name);
+            }
+        }
     }
+    println!("worst ratio {:.2} ({})", worst.0, worst.1);
 }
