@@ -313,13 +313,13 @@ impl<'a, const K: usize> KdStore<'a, K> {
     /// kernel). Returns the sum in W and the area it covers, or `None` for an empty or
     /// non-finite footprint. Unbiased for the patch's average irradiance, whatever its
     /// size or shape; the work is bounded by [`FOOTPRINT_VISITS`] photons per search.
-    #[inline]
+    #[inline(never)]
     fn gather_footprint(
         &self,
         x: Vec3,
         n: UnitVec3,
         footprint: &Footprint,
-        mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
+        weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> Option<(Rgb, f32)> {
         let region = Region::new(footprint, self.max_radius2)?;
         if self.out_of_reach(x) {
@@ -331,9 +331,9 @@ impl<'a, const K: usize> KdStore<'a, K> {
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
         let (mut region, mut level, mut cut) = (region, 0, false);
         loop {
-            let (sum, visits) = self.sum_in(levels[level], x, n, &region, cut, &mut weight);
+            let (sum, visits) = self.sum_in(levels[level], x, n, &region, cut, weight);
             if visits.is_some() {
-                let scale = (THINNING as f32).powi(level as i32);
+                let scale = [1, THINNING, THINNING * THINNING][level] as f32;
                 return Some((sum * (self.unit * scale), region.area));
             }
             if !cut && region.segments().0 > 1 {
@@ -348,7 +348,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
 
     /// The weighted sum of the front-side photons of `tree` inside `region` and the
     /// photons visited; `None` visits when they would exceed [`FOOTPRINT_VISITS`].
-    #[inline]
+    #[inline(never)]
     fn sum_in(
         &self,
         tree: Option<KdTree<'_>>,
@@ -356,7 +356,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
         n: UnitVec3,
         region: &Region,
         cut: bool,
-        weight: &mut impl FnMut(UnitVec3, Rgb) -> Rgb,
+        weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, Option<usize>) {
         let Some(tree) = tree else {
             return (Rgb::ZERO, Some(0));
@@ -465,7 +465,7 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// (the store's own estimate for an empty footprint).
     #[inline]
     fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Rgb {
-        match self.gather_footprint(x, n, footprint, |_, power| power) {
+        match self.gather_footprint(x, n, footprint, &mut |_, power| power) {
             Some((sum, area)) => sum * (1.0 / area),
             None => self.irradiance_near(x, n),
         }
@@ -482,8 +482,8 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         m: &Classic,
         footprint: &Footprint,
     ) -> Rgb {
-        let kernel = |dir: UnitVec3, power| m.kernel(n, -dir, to_eye) * power;
-        match self.gather_footprint(x, n, footprint, kernel) {
+        let mut kernel = |dir: UnitVec3, power| m.kernel(n, -dir, to_eye) * power;
+        match self.gather_footprint(x, n, footprint, &mut kernel) {
             Some((sum, area)) => sum * (PI / area),
             None => self.classic_near(x, n, to_eye, m),
         }

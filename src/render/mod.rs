@@ -445,8 +445,11 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
-                let turn = Turn::at(b, hit, object, facing);
                 let (wr, wt) = (b.weight * c.reflectivity, b.weight * c.transparency);
+                if !traced(wr + wt) {
+                    return (b.weight * local, None, None);
+                }
+                let turn = Turn::at(b, hit, object, facing);
                 // Under total internal reflection the transmitted part follows the
                 // reflected ray: one ray carries both.
                 let (reflected, refracted) = match interface(d, facing, eta).refracted {
@@ -538,7 +541,7 @@ struct Turn {
 impl Turn {
     /// Transfers `b`'s differentials to `hit` on `object`, whose normal facing the ray
     /// is `facing`.
-    #[inline]
+    #[inline(never)]
     fn at(b: &Branch, hit: &Hit, object: &Object, facing: UnitVec3) -> Self {
         let d = b.ray.dir.get();
         let at = b.diff.transfer(d, hit.t, hit.normal.get());
@@ -553,12 +556,12 @@ impl Turn {
         }
     }
 
-    #[inline]
+    #[inline(never)]
     fn reflect(&self) -> Differential {
         self.at.reflect(self.d, self.n, self.dn)
     }
 
-    #[inline]
+    #[inline(never)]
     fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
         self.at.refract(self.d, t.get(), self.n, self.dn, eta)
     }
