@@ -387,27 +387,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             diff,
         };
         match &object.material {
-            Material::Diffuse(m) => {
-                if !front {
-                    return (Rgb::ZERO, None, None);
-                }
-                let caustic = match self.gather(b, hit) {
-                    Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
-                    Gather::Store => self.store.irradiance(hit.point, hit.normal),
-                    Gather::Splatted => Rgb::ZERO,
-                };
-                let mut e = caustic;
-                for light in self.scene.lights() {
-                    let lit = self.direct_one(hit, light, count);
-                    log.mix(lit.is_some() as u32);
-                    if let Some((l, irradiance)) = lit {
-                        e += irradiance * hit.normal.dot(l.get());
-                    }
-                }
-                let f = b.weight * m.albedo;
-                log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
-                (f * e * core::f32::consts::FRAC_1_PI, None, None)
-            }
+            Material::Diffuse(m) if front => (self.diffuse(b, hit, m, count, log), None, None),
+            Material::Diffuse(_) => (Rgb::ZERO, None, None),
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
                 let reflected = traced(w).then(|| {
@@ -467,6 +448,35 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             // A specular surface after max_depth interactions contributes nothing.
             Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, None, None),
         }
+    }
+
+    /// Light a diffuse surface hit on its front reflects towards the eye along `b`:
+    /// `ρ/π · (E_caustic + Σ_lights I·cosθ/d²)`; the caustic part goes to `log`.
+    #[inline]
+    fn diffuse(
+        &self,
+        b: &Branch,
+        hit: &Hit,
+        m: &crate::material::Diffuse,
+        count: &mut RayCount,
+        log: &mut Sample,
+    ) -> Rgb {
+        let caustic = match self.gather(b, hit) {
+            Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
+            Gather::Store => self.store.irradiance(hit.point, hit.normal),
+            Gather::Splatted => Rgb::ZERO,
+        };
+        let mut e = caustic;
+        for light in self.scene.lights() {
+            let lit = self.direct_one(hit, light, count);
+            log.mix(lit.is_some() as u32);
+            if let Some((l, irradiance)) = lit {
+                e += irradiance * hit.normal.dot(l.get());
+            }
+        }
+        let f = b.weight * m.albedo;
+        log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
+        f * e * core::f32::consts::FRAC_1_PI
     }
 
     /// The classic model's local part at a front-side hit seen from `to_eye`.
