@@ -136,15 +136,9 @@ mod tests {
     /// of its length at all but 1% of them (a ray grazing a surface), the median to 0.1%.
     #[test]
     fn differentials_match_finite_differences_through_glass_and_mirrors() {
-        let camera = Camera::new(
-            Vec3::new(0.0, 2.0, 6.0),
-            Vec3::new(0.0, 0.5, 0.0),
-            Vec3::Y,
-            40.0,
-            320,
-            240,
-        )
-        .unwrap();
+        // The camera of the device's glass scene: (0, 4, 7) towards (0, 0.6, 0), 40°.
+        let scene = crate::demo::glass::<4, 1>(320, 240).unwrap();
+        let camera = scene.camera();
         let floor = Shape::plane(Vec3::new(0.0, 0.0, -3.0), Vec3::Z).unwrap();
         let ball = Shape::sphere(Vec3::new(0.0, 0.8, 0.0), 0.8).unwrap();
         let tube = Shape::cylinder(Vec3::new(-1.0, 0.8, 0.0), Vec3::X, 0.6, 2.0, false).unwrap();
