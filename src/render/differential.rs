@@ -87,7 +87,6 @@ impl Differential {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
     use crate::geometry::{Ray, Shape};
     use crate::material::interface;
     use crate::math::reflect;
