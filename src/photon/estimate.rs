@@ -241,11 +241,10 @@ impl<'a, const K: usize> KdStore<'a, K> {
         &self.tree
     }
 
-    /// Gathers the photons around `x` and sums `weight(photon)` over those that arrived
-    /// on the front of the surface of normal `n`, with the cone filter if any. Returns
-    /// the sum (in W, including the filter's normalisation) and r²: the `k` nearest
-    /// within the maximum radius (Jensen), or with a fixed radius every photon within
-    /// the maximum radius.
+    /// Gathers the photons around `x` — the k nearest within the maximum radius, or with
+    /// a fixed radius every photon within it — and sums `weight(photon)` over those that
+    /// arrived on the front of the surface of normal `n`, with the cone filter if any.
+    /// Returns the sum (in W, including the filter's normalisation) and r².
     #[inline]
     fn gather(
         &self,
@@ -261,50 +260,49 @@ impl<'a, const K: usize> KdStore<'a, K> {
             ),
             None => (0.0, 1.0),
         };
-        // The weighted power of one photon, `None` when it arrived from behind.
-        let mut contribution = |index: usize, dist2: f32, inv_kr: f32| {
+        let mut sum = Rgb::ZERO;
+        let mut add = |index: usize, dist2: f32, inv_kr: f32| {
             let p = &photons[index];
             let dir = p.direction();
             if n.dot(dir.get()) >= 0.0 {
-                return None;
+                return; // arrived from behind the surface
             }
             let w = if self.cone.is_some() {
                 1.0 - crate::math::sqrt(dist2) * inv_kr
             } else {
                 1.0
             };
-            Some(weight(dir, p.power()) * w)
+            sum += weight(dir, p.power()) * w;
         };
-        let Some(k) = self.k else {
-            let r2 = self.max_radius2;
-            let (inv_kr, norm) = filter(r2);
-            let mut sum = Rgb::ZERO;
-            self.tree.search(x, r2, |index, dist2| {
-                if let Some(c) = contribution(index, dist2, inv_kr) {
-                    sum += c;
+        let (r2, norm) = match self.k {
+            Some(k) => {
+                let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
+                let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
+                // Photon positions are known to about ε·|x|, and no estimate resolves
+                // detail below 10⁻⁴ of the gather radius: k photons all at the query
+                // point would otherwise divide by r² = 0. Floor r² there.
+                let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
+                let floor = crate::math::max(
+                    crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
+                    f32::MIN_POSITIVE,
+                );
+                let r2 = crate::math::max(found.radius2, floor);
+                let (inv_kr, norm) = filter(r2);
+                for nb in &buf {
+                    add(nb.index as usize, nb.dist2, inv_kr);
                 }
-                r2
-            });
-            return (sum * (self.unit * norm), r2);
-        };
-        let mut buf: heapless::Vec<Neighbor, K> = heapless::Vec::new();
-        let found = self.tree.k_nearest(x, self.max_radius2, k, &mut buf);
-        // Photon positions are known to about ε·|x|, and no estimate resolves detail
-        // below 10⁻⁴ of the gather radius: k photons all at the query point would
-        // otherwise divide by r² = 0. Floor r² there.
-        let ulp = 4.0 * f32::EPSILON * crate::math::max_abs(x);
-        let floor = crate::math::max(
-            crate::math::max(ulp * ulp, 1e-8 * self.max_radius2),
-            f32::MIN_POSITIVE,
-        );
-        let r2 = crate::math::max(found.radius2, floor);
-        let (inv_kr, norm) = filter(r2);
-        let mut sum = Rgb::ZERO;
-        for nb in &buf {
-            if let Some(c) = contribution(nb.index as usize, nb.dist2, inv_kr) {
-                sum += c;
+                (r2, norm)
             }
-        }
+            None => {
+                let r2 = self.max_radius2;
+                let (inv_kr, norm) = filter(r2);
+                self.tree.search(x, r2, |index, dist2| {
+                    add(index, dist2, inv_kr);
+                    r2
+                });
+                (r2, norm)
+            }
+        };
         (sum * (self.unit * norm), r2)
     }
 
@@ -371,10 +369,15 @@ impl<'a, const K: usize> KdStore<'a, K> {
         };
         let step = 2.0 / segments as f32;
         let piece = long * (1.0 / segments as f32);
-        let reach2 = crate::math::max(
-            (piece + short).length_squared(),
-            (piece - short).length_squared(),
-        );
+        // One segment searches the region's own reach (computed once, with it).
+        let reach2 = if segments == 1 {
+            region.reach2
+        } else {
+            crate::math::max(
+                (piece + short).length_squared(),
+                (piece - short).length_squared(),
+            )
+        };
         for j in 0..segments {
             // Segment j holds the long coordinate in [−1 + j·step, −1 + (j+1)·step)
             // (the last one closed): every photon is counted once.
@@ -385,7 +388,6 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 lo + step
             };
             let centre = x + long * (lo + 0.5 * step);
-            let reach2 = if segments == 1 { region.reach2 } else { reach2 };
             tree.search(centre, reach2, |index, _| {
                 visited += 1;
                 if visited > FOOTPRINT_VISITS {
@@ -410,28 +412,6 @@ impl<'a, const K: usize> KdStore<'a, K> {
     }
 }
 
-impl<const K: usize> KdStore<'_, K> {
-    /// `E = Σ Φ_p / (π r²)` over the photons of [`gather`](Self::gather).
-    #[inline]
-    fn irradiance_near(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        if self.out_of_reach(x) {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |_, power| power);
-        sum * (1.0 / (PI * r2))
-    }
-
-    /// Paper eq. 8 over the photons of [`gather`](Self::gather).
-    #[inline]
-    fn classic_near(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        if self.out_of_reach(x) {
-            return Rgb::ZERO;
-        }
-        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
-        sum * (1.0 / r2)
-    }
-}
-
 /// The bounding box of the photons' positions, `(lo, hi)`; `lo = +∞`, `hi = −∞`
 /// without photons.
 fn bounds(photons: &[Photon]) -> (Vec3, Vec3) {
@@ -452,13 +432,21 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     /// divided by the diffuse BRDF.
     #[inline]
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
-        self.irradiance_near(x, n)
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, |_, power| power);
+        sum * (1.0 / (PI * r2))
     }
 
     /// Paper eq. 8: `c = (1/r²) Σ (max(n·l,0)·k_d·color + max(n·h,0)^a·k_s·color)·energy`.
     #[inline]
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
-        self.classic_near(x, n, to_eye, m)
+        if self.out_of_reach(x) {
+            return Rgb::ZERO;
+        }
+        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
+        sum * (1.0 / r2)
     }
 
     /// `E = Σ Φ_p / A` over the front-side photons inside the footprint of area `A`
@@ -467,7 +455,7 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
     fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Rgb {
         match self.gather_footprint(x, n, footprint, &mut |_, power| power) {
             Some((sum, area)) => sum * (1.0 / area),
-            None => self.irradiance_near(x, n),
+            None => self.irradiance(x, n),
         }
     }
 
@@ -485,7 +473,7 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         let mut kernel = |dir: UnitVec3, power| m.kernel(n, -dir, to_eye) * power;
         match self.gather_footprint(x, n, footprint, &mut kernel) {
             Some((sum, area)) => sum * (PI / area),
-            None => self.classic_near(x, n, to_eye, m),
+            None => self.classic(x, n, to_eye, m),
         }
     }
 }
