@@ -15,7 +15,8 @@
 //! with `∂(D·N) = ∂D·N + D·∂N` and `∂N` from the shape
 //! ([`Shape::normal_derivative`](crate::geometry::Shape::normal_derivative)).
 
-use crate::math::Vec3;
+use crate::geometry::{Hit, Shape};
+use crate::math::{UnitVec3, Vec3};
 
 /// The derivatives of a ray's origin and direction along the image's x and y, per step
 /// of the sample's extent on the image (a pixel, or a sub-pixel of a grid).
@@ -84,10 +85,57 @@ impl Differential {
     }
 }
 
+/// A branch's differentials transferred to a specular hit, with the normal facing the
+/// ray and that normal's turn across the sample: what the reflected and refracted
+/// branches' differentials are made from.
+pub(crate) struct Turn {
+    at: Differential,
+    d: Vec3,
+    n: Vec3,
+    dn: [Vec3; 2],
+}
+
+impl Turn {
+    /// Transfers `diff`, of a ray along `d`, to `hit` on `shape`, whose normal facing
+    /// the ray is `facing`.
+    #[inline(never)]
+    pub fn at(
+        diff: &Differential,
+        d: UnitVec3,
+        hit: &Hit,
+        shape: &Shape,
+        facing: UnitVec3,
+    ) -> Self {
+        let d = d.get();
+        let at = diff.transfer(d, hit.t, hit.normal.get());
+        // The outward normal's turn, flipped with the normal when the ray is inside.
+        let sign = if facing == hit.normal { 1.0 } else { -1.0 };
+        let turn = |i: usize| shape.normal_derivative(hit.normal, at.dp[i]) * sign;
+        Self {
+            at,
+            d,
+            n: facing.get(),
+            dn: [turn(0), turn(1)],
+        }
+    }
+
+    /// The mirror-reflected branch's differentials.
+    #[inline(never)]
+    pub fn reflect(&self) -> Differential {
+        self.at.reflect(self.d, self.n, self.dn)
+    }
+
+    /// The refracted branch's differentials, along `t`, with `eta = η_i/η_t`.
+    #[inline(never)]
+    pub fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
+        self.at.refract(self.d, t.get(), self.n, self.dn, eta)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{Ray, Shape};
+    use crate::geometry::Ray;
     use crate::material::interface;
     use crate::math::reflect;
 
@@ -107,16 +155,13 @@ mod tests {
             let d = ray.dir;
             let front = hit.front_face(d);
             let facing = if front { hit.normal } else { -hit.normal };
-            let at = diff.transfer(d.get(), hit.t, hit.normal.get());
-            let sign = if front { 1.0 } else { -1.0 };
-            let dn = [0, 1].map(|i| shape.normal_derivative(hit.normal, at.dp[i]) * sign);
+            let turn = Turn::at(&diff, d, &hit, shape, facing);
             let (dir, next) = if *mirror {
-                let r = reflect(d, facing);
-                (r, at.reflect(d.get(), facing.get(), dn))
+                (reflect(d, facing), turn.reflect())
             } else {
                 let eta = if front { 1.0 / 1.5 } else { 1.5 };
                 let t = interface(d, facing, eta).refracted?;
-                (t, at.refract(d.get(), t.get(), facing.get(), dn, eta))
+                (t, turn.refract(t, eta))
             };
             ray = Ray::spawn(&hit, dir);
             diff = next;

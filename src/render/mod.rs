@@ -63,15 +63,15 @@ use heapless::Vec as FixedVec;
 use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
-use crate::math::{reflect, Rgb, UnitVec3, Vec3};
+use crate::math::{reflect, Rgb, UnitVec3};
 use crate::photon::{CausticStore, Footprint, Splat};
-use differential::Differential;
+use crate::scene::{Object, Scene};
+use differential::{Differential, Turn};
 
 mod differential;
 mod estimate;
 mod pixels;
 
-use crate::scene::{Object, Scene};
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
 
@@ -304,7 +304,6 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
         let [dx, dy] = self.scene.camera().direction_derivatives(ray.dir);
-
         let step = 1.0 / m.max(1) as f32;
         let mut next = Some(Branch {
             ray,
@@ -392,7 +391,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
                 let reflected = traced(w).then(|| {
-                    let turn = Turn::at(b, hit, object, facing);
+                    let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
                     branch(reflect(d, facing), w, turn.reflect())
                 });
                 (Rgb::ZERO, reflected, None)
@@ -405,7 +404,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 };
                 let eta = if front { 1.0 / g.ior } else { g.ior };
                 let i = interface(d, facing, eta);
-                let turn = Turn::at(b, hit, object, facing);
+                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
                 let w = weight * i.reflectance;
                 let reflected = traced(w).then(|| branch(reflect(d, facing), w, turn.reflect()));
                 let w = weight * ((1.0 - i.reflectance) * eta * eta);
@@ -430,7 +429,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !traced(wr + wt) {
                     return (b.weight * local, None, None);
                 }
-                let turn = Turn::at(b, hit, object, facing);
+                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
                 // Under total internal reflection the transmitted part follows the
                 // reflected ray: one ray carries both.
                 let (reflected, refracted) = match interface(d, facing, eta).refracted {
@@ -536,43 +535,5 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             return None;
         }
         Some((l, light.intensity() * (1.0 / d2)))
-    }
-}
-
-/// A branch's differentials at a specular hit, with the facing normal and its turn
-/// across the sample: what the reflected and refracted branches' differentials need.
-struct Turn {
-    at: Differential,
-    d: Vec3,
-    n: Vec3,
-    dn: [Vec3; 2],
-}
-
-impl Turn {
-    /// Transfers `b`'s differentials to `hit` on `object`, whose normal facing the ray
-    /// is `facing`.
-    #[inline(never)]
-    fn at(b: &Branch, hit: &Hit, object: &Object, facing: UnitVec3) -> Self {
-        let d = b.ray.dir.get();
-        let at = b.diff.transfer(d, hit.t, hit.normal.get());
-        // The outward normal's turn, flipped with the normal when the ray is inside.
-        let sign = if facing == hit.normal { 1.0 } else { -1.0 };
-        let turn = |i: usize| object.shape.normal_derivative(hit.normal, at.dp[i]) * sign;
-        Self {
-            at,
-            d,
-            n: facing.get(),
-            dn: [turn(0), turn(1)],
-        }
-    }
-
-    #[inline(never)]
-    fn reflect(&self) -> Differential {
-        self.at.reflect(self.d, self.n, self.dn)
-    }
-
-    #[inline(never)]
-    fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
-        self.at.refract(self.d, t.get(), self.n, self.dn, eta)
     }
 }
