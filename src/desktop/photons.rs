@@ -169,11 +169,16 @@ impl PhotonBuffer {
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
         // Every THINNING-th photon in emission order: a selection that does not depend
-        // on where the photons landed, so each stands for THINNING of them.
+        // on where the photons landed, so each stands for THINNING of them. Only the
+        // footprint gathers behind glass read them, and those need the camera splats.
         let thin = |from: &[Photon]| -> vec::Vec<Photon> {
             from.iter().step_by(THINNING).copied().collect()
         };
-        let level1 = thin(&self.photons[..stored]);
+        let level1 = if settings.camera_splats() {
+            thin(&self.photons[..stored])
+        } else {
+            vec::Vec::new()
+        };
         let level2 = thin(&level1);
         self.coarse = [level1, level2];
         for level in &mut self.coarse {
