@@ -324,10 +324,12 @@ impl<'a, const K: usize> KdStore<'a, K> {
             return Some((Rgb::ZERO, region.area));
         }
         // The finest level where the footprint visits at most FOOTPRINT_VISITS
-        // photons: a search that would visit more stops there and is tried again — a
-        // sliver cut into disks, then on the next coarser level, at last scaled down.
+        // photons, as the coarsest level's count predicts it: a search that would visit
+        // more stops there and is tried again — a sliver cut into disks, then on the
+        // next coarser level, at last scaled down.
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
-        let (mut region, mut level, mut cut) = (region, 0, false);
+        let level = self.first_level(x, n, &region);
+        let (mut region, mut level, mut cut) = (region, level, false);
         loop {
             let (sum, visits) = self.sum_in(levels[level], x, n, &region, cut, weight);
             if visits.is_some() {
@@ -341,6 +343,23 @@ impl<'a, const K: usize> KdStore<'a, K> {
             } else {
                 region = region.scaled(0.25);
             }
+        }
+    }
+
+    /// The level to try first: the finest whose photons in the region's reach are
+    /// predicted, from the coarsest level's count, not to exceed [`FOOTPRINT_VISITS`].
+    fn first_level(&self, x: Vec3, n: UnitVec3, region: &Region) -> usize {
+        let Some(coarsest) = self.coarse[1] else {
+            return 0;
+        };
+        let (_, visits) = self.sum_in(Some(coarsest), x, n, region, false, &mut |_, _| Rgb::ZERO);
+        let Some(v) = visits else { return 2 };
+        if v * THINNING * THINNING <= FOOTPRINT_VISITS {
+            0
+        } else if v * THINNING <= FOOTPRINT_VISITS {
+            1
+        } else {
+            2
         }
     }
 
@@ -394,13 +413,17 @@ impl<'a, const K: usize> KdStore<'a, K> {
                     return 0.0; // ends the search
                 }
                 let p = &photons[index];
-                let dir = p.direction();
-                let inside = region.coords(p.position() - x).filter(|&(alpha, beta)| {
-                    let t = if along_b { beta } else { alpha };
-                    segments == 1 || (t >= lo && t < hi)
-                });
-                if inside.is_some() && n.dot(dir.get()) < 0.0 {
-                    sum += weight(dir, p.power());
+                let inside = region
+                    .coords(p.position() - x)
+                    .is_some_and(|(alpha, beta)| {
+                        let t = if along_b { beta } else { alpha };
+                        segments == 1 || (t >= lo && t < hi)
+                    });
+                if inside {
+                    let dir = p.direction();
+                    if n.dot(dir.get()) < 0.0 {
+                        sum += weight(dir, p.power());
+                    }
                 }
                 reach2
             });
