@@ -19,7 +19,9 @@ use super::progress::Progress;
 use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::photon::{self, add_to_frame, CausticStore, Footprint, Photon, PhotonSettings, Splat};
+use crate::photon::{
+    self, add_to_frame, CausticStore, Footprint, Halves, Photon, PhotonSettings, Splat,
+};
 use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
 use crate::Error;
 
@@ -174,10 +176,17 @@ impl<S: CausticStore> CausticStore for Timed<'_, S> {
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
         self.time(|| self.inner.classic(x, n, to_eye, m))
     }
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, f: &Footprint) -> Rgb {
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, f: &Footprint) -> Halves {
         self.time(|| self.inner.irradiance_within(x, n, f))
     }
-    fn classic_within(&self, x: Vec3, n: UnitVec3, e: UnitVec3, m: &Classic, f: &Footprint) -> Rgb {
+    fn classic_within(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        e: UnitVec3,
+        m: &Classic,
+        f: &Footprint,
+    ) -> Halves {
         self.time(|| self.inner.classic_within(x, n, e, m, f))
     }
 }

@@ -17,7 +17,8 @@ mod packed;
 mod splat;
 mod trace;
 
-pub use estimate::{ConeFilter, Footprint, KdStore, FOOTPRINT_VISITS, THINNING};
+pub use estimate::{ConeFilter, Footprint, KdStore, FOOTPRINT_VISITS, SPARSE_FOOTPRINT, THINNING};
+
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
@@ -51,10 +52,12 @@ pub trait CausticStore {
 
     /// As [`irradiance`](Self::irradiance), averaged over the patch one eye sample
     /// stands for (a diffuse point seen through glass or in a mirror): the box filter of
-    /// a pixel. A store that cannot restrict its estimate to the patch ignores it.
-    fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Rgb {
+    /// a pixel, with the difference of its two halves' estimates. A store that cannot
+    /// restrict its estimate to the patch ignores it, and one that cannot split it
+    /// reports no difference.
+    fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Halves {
         let _ = footprint;
-        self.irradiance(x, n)
+        Halves::whole(self.irradiance(x, n))
     }
 
     /// As [`classic`](Self::classic), over the patch one eye sample stands for.
@@ -65,9 +68,49 @@ pub trait CausticStore {
         to_eye: UnitVec3,
         material: &Classic,
         footprint: &Footprint,
-    ) -> Rgb {
+    ) -> Halves {
         let _ = footprint;
-        self.classic(x, n, to_eye, material)
+        Halves::whole(self.classic(x, n, to_eye, material))
+    }
+}
+
+/// A caustic estimate from all photons, and the difference between the parts of the
+/// forward pass's two independent halves ([`Emitter`]: photon `i` of a light belongs
+/// to half `i mod 2` and carries `n_h/n` of its half's power, so the parts add up to
+/// the total). With `A`, `B` the two parts (i.i.d., each of variance `σ²`), the total
+/// `A + B` has variance `2σ²` and `E[(A − B)²] = 2σ²`: the squared difference estimates
+/// the total's squared error (batch means with two batches).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Halves {
+    /// The estimate: half 0's part plus half 1's.
+    pub total: Rgb,
+    /// Half 0's part minus half 1's.
+    pub split: Rgb,
+}
+
+impl Halves {
+    /// An estimate that cannot be split: no difference.
+    pub fn whole(total: Rgb) -> Self {
+        Self {
+            total,
+            split: Rgb::ZERO,
+        }
+    }
+
+    /// Both scaled by `s`.
+    pub fn scaled(self, s: f32) -> Self {
+        Self {
+            total: self.total * s,
+            split: self.split * s,
+        }
+    }
+
+    /// From the parts of half 0 and half 1.
+    pub fn from_parts(half0: Rgb, half1: Rgb) -> Self {
+        Self {
+            total: half0 + half1,
+            split: half0 - half1,
+        }
     }
 }
 
@@ -377,7 +420,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 landing.hit.point,
                 landing.dir,
                 landing.power * (1.0 / self.unit),
-            ),
+            )
+            .with_half(i & 1 == 1),
             object: landing.object,
             splat,
         })

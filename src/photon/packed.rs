@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | 0 | position x: `f32` rounded to 16 mantissa bits | direction bits 0–6 |
 //! | 1 | position y, likewise | direction bits 7–13 |
-//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), balancing scratch (1 bit), 2 spare |
+//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), balancing scratch (1 bit), forward-pass half (1 bit), 1 spare |
 //! | 3 | power: shared-exponent RGB (Ward's RGBE), relative to the map's power unit | |
 //!
 //! The direction of travel is an octahedral map, 8 bits per coordinate (Cigolle et
@@ -32,6 +32,7 @@ const PAYLOAD: u32 = 0x7f;
 const AXIS_SHIFT: u32 = 2;
 const AXIS_BITS: u32 = 0b11 << AXIS_SHIFT;
 const SCRATCH_BIT: u32 = 1 << 4;
+const HALF_BIT: u32 = 1 << 5;
 
 /// `x` rounded to nearest at bit 7 of its pattern (a carry into the exponent is the
 /// correct rounding); truncated instead where rounding would overflow to infinity.
@@ -89,6 +90,21 @@ impl Photon {
         let [a, b, c, _] = self.words;
         let d = (a & PAYLOAD) | ((b & PAYLOAD) << 7) | ((c & 0b11) << 14);
         decode_octahedral((d as u16).to_le_bytes())
+    }
+
+    /// The same photon marked as one of the forward pass's half 1 (`true`) or half 0:
+    /// the two independent halves whose difference estimates a gather's noise
+    /// ([`Halves`](super::Halves)).
+    #[inline]
+    pub fn with_half(mut self, half: bool) -> Self {
+        self.words[2] = (self.words[2] & !HALF_BIT) | if half { HALF_BIT } else { 0 };
+        self
+    }
+
+    /// Which half of the forward pass it belongs to (see [`with_half`](Self::with_half)).
+    #[inline]
+    pub fn half(&self) -> bool {
+        self.words[2] & HALF_BIT != 0
     }
 
     /// The kd-tree split axis of this node (0, 1, 2).
@@ -219,11 +235,12 @@ mod tests {
             ))
             .unwrap();
             let power = Rgb::new(g.next_f32(), g.next_f32(), 2.0);
-            let mut p = Photon::new(pos, dir, power);
+            let mut p = Photon::new(pos, dir, power).with_half(i % 3 == 0);
             for axis in [2, 0, 1] {
                 p.set_axis(axis);
                 p.set_scratch(axis == 0);
                 assert_eq!((p.axis(), p.scratch()), (axis, axis == 0));
+                assert_eq!(p.half(), i % 3 == 0);
                 assert_eq!(p.direction(), decode_octahedral(encode_octahedral(dir)));
                 assert_eq!(p.power(), decode_rgbe(encode_rgbe(power)));
                 for k in 0..3 {

@@ -3,17 +3,19 @@
 //! Each pixel carries two error terms, each estimated from two independent halves of
 //! the same budget (batch means; the difference of two i.i.d. estimates `A`, `B` of
 //! the same value has `E[(A − B)²] = 2σ²`, so their mean has variance `E[(A − B)²]/4`):
-//! - the light tracer's: the forward pass's two randomised-QMC halves
-//!   ([`Emitter`](crate::photon::Emitter)) each splat their photons; with `F_h` the sum
-//!   of half `h`'s splats in the pixel (each photon already weighted by `n_h/n`), the
-//!   total `F₀ + F₁` has squared error about `(F₀ − F₁)²`;
+//! - the photons': the forward pass's two randomised-QMC halves
+//!   ([`Emitter`](crate::photon::Emitter)) each splat their photons and each store
+//!   theirs (a photon knows its half); with `F_h` the sum of half `h`'s splats in the
+//!   pixel and of its photons in the pixel's gathers behind glass (each photon already
+//!   weighted by `n_h/n`), the total `F₀ + F₁` has squared error about `(F₀ − F₁)²`
+//!   ([`Halves`](crate::photon::Halves));
 //! - the sub-pixel sampling's: in a supersampled pixel, the two checkerboard halves of
 //!   its grid ([`Sampling`](super::Sampling)) give `((m_a − m_b)/2)²`.
 //!
-//! Not estimated, and stated where it is reported: the noise of the gather behind
-//! glass and mirrors in a pixel that was not supersampled (a supersampled pixel's
-//! checkerboard halves gather over disjoint halves of its preimage, so their
-//! difference holds it), the gather's bias where the ray differentials' linear
+//! In a supersampled pixel the checkerboard halves gather over disjoint halves of its
+//! preimage, so their difference holds the gathers' noise, which the pixel's split
+//! then leaves out. Not estimated, and stated where it is reported: the gather's bias
+//! where the ray differentials' linear
 //! preimage of the pixel departs from the true one (at a silhouette or a fold of the
 //! focus; a supersampled pixel's sub-pixels shrink it), and the error of a pixel whose
 //! four corners agreed (smooth there by the test that let them agree).
@@ -28,7 +30,8 @@ pub struct PixelEstimate {
     pub radiance: Rgb,
     /// The caustic part of `radiance`: the splats and the gathers behind glass.
     pub caustic: Rgb,
-    /// The splats of the forward pass's half 0 minus those of half 1.
+    /// The caustic part from the forward pass's half 0 minus half 1's: the splats, and
+    /// the gathers where the pixel was not supersampled.
     pub split: Rgb,
     /// The estimated squared error of the sub-pixel sampling, per channel.
     pub sampling2: Rgb,

@@ -64,7 +64,7 @@ use crate::error::Error;
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
-use crate::photon::{CausticStore, Footprint, Splat};
+use crate::photon::{CausticStore, Footprint, Halves, Splat};
 use crate::scene::{Object, Scene};
 use differential::{Differential, Turn};
 
@@ -162,6 +162,9 @@ pub struct Sample {
     pub radiance: Rgb,
     /// The part of `radiance` the caustic store gathered.
     pub caustic: Rgb,
+    /// That part's estimate from the forward pass's half 0 minus half 1's
+    /// ([`Halves`]): its noise.
+    pub split: Rgb,
     /// FNV-1a hash of the path's events.
     pub signature: u32,
 }
@@ -170,6 +173,7 @@ impl Sample {
     const START: Sample = Sample {
         radiance: Rgb::ZERO,
         caustic: Rgb::ZERO,
+        split: Rgb::ZERO,
         signature: 0x811c_9dc5,
     };
 
@@ -462,10 +466,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     ) -> Rgb {
         let caustic = match self.gather(b, hit) {
             Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
-            Gather::Store => self.store.irradiance(hit.point, hit.normal),
-            Gather::Splatted => Rgb::ZERO,
+            Gather::Store => Halves::whole(self.store.irradiance(hit.point, hit.normal)),
+            Gather::Splatted => Halves::default(),
         };
-        let mut e = caustic;
+        let mut e = caustic.total;
         for light in self.scene.lights() {
             let lit = self.direct_one(hit, light, count);
             log.mix(lit.is_some() as u32);
@@ -474,7 +478,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         let f = b.weight * m.albedo;
-        log.caustic += f * caustic * core::f32::consts::FRAC_1_PI;
+        log.caustic += f * caustic.total * core::f32::consts::FRAC_1_PI;
+        log.split += f * caustic.split * core::f32::consts::FRAC_1_PI;
         f * e * core::f32::consts::FRAC_1_PI
     }
 
@@ -500,11 +505,12 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
         let caustic = match self.gather(b, hit) {
             Gather::Footprint(f) => self.store.classic_within(hit.point, n, to_eye, c, &f),
-            Gather::Store => self.store.classic(hit.point, n, to_eye, c),
-            Gather::Splatted => Rgb::ZERO,
+            Gather::Store => Halves::whole(self.store.classic(hit.point, n, to_eye, c)),
+            Gather::Splatted => Halves::default(),
         };
-        log.caustic += b.weight * caustic;
-        ambient + lit + caustic
+        log.caustic += b.weight * caustic.total;
+        log.split += b.weight * caustic.split;
+        ambient + lit + caustic.total
     }
 
     /// Direction `l` and normal-incidence irradiance `I/d²` of one light if it shines

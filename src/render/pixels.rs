@@ -81,10 +81,14 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Pixel `(x, y)` as the mean of an `n × n` grid of sub-pixel rays. Its sampling
     /// error is estimated from the grid's two checkerboard halves `a`, `b` as
     /// `((m_a − m_b)/2)²` per channel: the batch-means estimate for two half-grids.
+    /// The halves gather over disjoint halves of the pixel's preimage, so this holds the
+    /// gathers' noise too, and the gathers' own [`split`](Sample::split) is left out
+    /// (it would count that noise twice).
     fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> PixelEstimate {
         let step = 1.0 / n as f32;
         let camera = self.scene.camera();
         let mut half = [(Rgb::ZERO, Rgb::ZERO, 0u32); 2];
+        let mut split = Rgb::ZERO;
         for sy in 0..n {
             for sx in 0..n {
                 let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
@@ -93,6 +97,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 h.0 += s.radiance;
                 h.1 += s.caustic;
                 h.2 += 1;
+                split += s.split;
             }
         }
         let inv = 1.0 / (n * n) as f32;
@@ -106,7 +111,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         PixelEstimate {
             radiance: (half[0].0 + half[1].0) * inv,
             caustic: (half[0].1 + half[1].1) * inv,
-            split: Rgb::ZERO,
+            split: split * inv,
             sampling2,
         }
     }
@@ -155,6 +160,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let one = |s: Sample| PixelEstimate {
             radiance: s.radiance,
             caustic: s.caustic,
+            split: s.split,
             ..PixelEstimate::default()
         };
         match self.sampling {
@@ -185,6 +191,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                             PixelEstimate {
                                 radiance: mean(|s| s.radiance),
                                 caustic: mean(|s| s.caustic),
+                                split: mean(|s| s.split),
                                 ..PixelEstimate::default()
                             }
                         } else {
