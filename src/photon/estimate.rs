@@ -449,6 +449,12 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         sum * (1.0 / r2)
     }
 
+    /// `false` beyond the maximum radius from the photons' bounding box.
+    #[inline]
+    fn reaches(&self, x: Vec3) -> bool {
+        !self.out_of_reach(x)
+    }
+
     /// `E = Σ Φ_p / A` over the front-side photons inside the footprint of area `A`
     /// (the store's own estimate for an empty footprint).
     #[inline]

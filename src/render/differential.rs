@@ -15,8 +15,12 @@
 //! with `∂(D·N) = ∂D·N + D·∂N` and `∂N` from the shape
 //! ([`Shape::normal_derivative`](crate::geometry::Shape::normal_derivative)).
 
+use heapless::Vec as FixedVec;
+
+use crate::camera::Camera;
 use crate::geometry::{Hit, Shape};
 use crate::math::{UnitVec3, Vec3};
+use crate::scene::Object;
 
 /// The derivatives of a ray's origin and direction along the image's x and y, per step
 /// of the sample's extent on the image (a pixel, or a sub-pixel of a grid).
@@ -96,21 +100,27 @@ pub(crate) struct Turn {
 }
 
 impl Turn {
-    /// Transfers `diff`, of a ray along `d`, to `hit` on `shape`, whose normal facing
-    /// the ray is `facing`.
+    /// Transfers `diff`, of a ray along `d`, to its hit `t` along it on `shape`, of
+    /// outward normal `normal` there; `front`: the ray arrived on the side `normal`
+    /// points to.
     #[inline(never)]
     pub fn at(
         diff: &Differential,
         d: UnitVec3,
-        hit: &Hit,
+        (t, normal): (f32, UnitVec3),
         shape: &Shape,
-        facing: UnitVec3,
+        front: bool,
     ) -> Self {
         let d = d.get();
-        let at = diff.transfer(d, hit.t, hit.normal.get());
-        // The outward normal's turn, flipped with the normal when the ray is inside.
-        let sign = if facing == hit.normal { 1.0 } else { -1.0 };
-        let turn = |i: usize| shape.normal_derivative(hit.normal, at.dp[i]) * sign;
+        let at = diff.transfer(d, t, normal.get());
+        // The normal facing the ray, and its turn: the outward normal's, flipped with it
+        // when the ray is inside.
+        let (facing, sign) = if front {
+            (normal, 1.0)
+        } else {
+            (-normal, -1.0)
+        };
+        let turn = |i: usize| shape.normal_derivative(normal, at.dp[i]) * sign;
         Self {
             at,
             d,
@@ -129,6 +139,115 @@ impl Turn {
     #[inline(never)]
     pub fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
         self.at.refract(self.d, t.get(), self.n, self.dn, eta)
+    }
+}
+
+/// How a branch leaves the specular vertex it starts at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Bend {
+    /// Mirror reflection (also a classic surface's transmitted part under total
+    /// internal reflection, which follows the reflected ray).
+    Reflect,
+    /// Refraction, with `η = η_i/η_t` of the vertex.
+    Refract,
+}
+
+/// One specular interaction of the path being traced: what [`Turn::at`] and the bend
+/// of the branch leaving it need, recorded instead of the differentials themselves.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    /// The arriving ray's direction, and how it left the vertex before (the arriving
+    /// branch's bend; unused at the first vertex, which the camera ray reaches).
+    d: UnitVec3,
+    bend: Bend,
+    /// The hit: ray parameter, outward normal, object, side.
+    t: f32,
+    normal: UnitVec3,
+    object: usize,
+    front: bool,
+    /// `η_i/η_t` for a refracted branch.
+    eta: f32,
+}
+
+/// The specular vertices of the eye path being traced, from the camera, replayed into
+/// a branch's differentials only where a gather needs them (Igehy's recurrences in the
+/// same order on the same values: the same bits as carrying them along every branch).
+/// Most branches never reach a diffuse point near a photon (Fig. 6 on the device:
+/// 80 footprint gathers against 12 300 reflected and refracted branches), so carrying
+/// 48 bytes of differentials through every fork costs far more than replaying a few.
+///
+/// The walk is depth-first and each pending branch waits at a depth of its own, so
+/// when a branch at depth `k` is traced the first `k` vertices are its own ancestors:
+/// a vertex recorded at depth `k` replaces everything from `k` on.
+#[derive(Debug)]
+pub(crate) struct Trail<const DEPTH: usize> {
+    vertices: FixedVec<Vertex, DEPTH>,
+    /// The sample's extent on the image, pixels (`1/m` for an `m × m` grid).
+    step: f32,
+}
+
+impl<const DEPTH: usize> Trail<DEPTH> {
+    /// No vertex yet, for a sample `step` pixels wide.
+    #[inline]
+    pub fn new(step: f32) -> Self {
+        Self {
+            vertices: FixedVec::new(),
+            step,
+        }
+    }
+
+    /// Records the specular hit of a branch at `depth` that arrived along `d` by `bend`,
+    /// on `object` (the scene's index); `eta` for its refracted branch.
+    #[inline]
+    pub fn record(
+        &mut self,
+        depth: u32,
+        (d, bend): (UnitVec3, Bend),
+        hit: &Hit,
+        object: usize,
+        eta: f32,
+    ) {
+        self.vertices.truncate(depth as usize);
+        let vertex = Vertex {
+            d,
+            bend,
+            t: hit.t,
+            normal: hit.normal,
+            object,
+            front: hit.front_face(d),
+            eta,
+        };
+        if self.vertices.push(vertex).is_err() {
+            debug_assert!(false, "trail overflow: DEPTH < max_depth");
+        }
+    }
+
+    /// The differentials of the branch at `depth` that left its last vertex along `dir`
+    /// by `bend`: the camera's, carried through the first `depth` vertices.
+    #[inline(never)]
+    pub fn differential(
+        &self,
+        camera: &Camera,
+        objects: &[Object],
+        depth: u32,
+        (dir, bend): (UnitVec3, Bend),
+    ) -> Differential {
+        let path = &self.vertices[..(depth as usize).min(self.vertices.len())];
+        let root = path.first().map_or(dir, |v| v.d);
+        let [dx, dy] = camera.direction_derivatives(root);
+        let mut diff = Differential::camera([dx * self.step, dy * self.step]);
+        for (k, v) in path.iter().enumerate() {
+            let (out, bend) = path
+                .get(k + 1)
+                .map_or((dir, bend), |next| (next.d, next.bend));
+            let shape = &objects[v.object].shape;
+            let turn = Turn::at(&diff, v.d, (v.t, v.normal), shape, v.front);
+            diff = match bend {
+                Bend::Reflect => turn.reflect(),
+                Bend::Refract => turn.refract(out, v.eta),
+            };
+        }
+        diff
     }
 }
 
@@ -155,7 +274,7 @@ mod tests {
             let d = ray.dir;
             let front = hit.front_face(d);
             let facing = if front { hit.normal } else { -hit.normal };
-            let turn = Turn::at(&diff, d, &hit, shape, facing);
+            let turn = Turn::at(&diff, d, (hit.t, hit.normal), shape, front);
             let (dir, next) = if *mirror {
                 (reflect(d, facing), turn.reflect())
             } else {

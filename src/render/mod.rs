@@ -65,8 +65,8 @@ use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
 use crate::photon::{CausticStore, Footprint, Splat};
-use crate::scene::{Object, Scene};
-use differential::{Differential, Turn};
+use crate::scene::Scene;
+use differential::{Bend, Trail};
 
 mod differential;
 mod estimate;
@@ -136,6 +136,8 @@ impl core::ops::AddAssign for RayCount {
 enum Gather {
     /// The forward pass's splats hold it already (seen directly): no gather.
     Splatted,
+    /// No photon can lie within the store's reach: the footprint's estimate is zero.
+    Dark,
     /// The store's own gather, as its settings say (the paper's way, without splats).
     Store,
     /// The photons within the patch the sample stands for, from its ray differentials
@@ -149,9 +151,9 @@ struct Branch {
     ray: Ray,
     weight: Rgb,
     depth: u32,
-    /// How the ray moves across the sample's extent on the image (its pixel, or its
-    /// sub-pixel in a grid).
-    diff: Differential,
+    /// How it left the specular vertex it starts at (the camera's ray: `Reflect`,
+    /// unused): with the [`Trail`] of vertices, what its ray differentials are made from.
+    bend: Bend,
 }
 
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
@@ -303,13 +305,12 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
-        let [dx, dy] = self.scene.camera().direction_derivatives(ray.dir);
-        let step = 1.0 / m.max(1) as f32;
+        let mut trail = Trail::new(1.0 / m.max(1) as f32);
         let mut next = Some(Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
-            diff: Differential::camera([dx * step, dy * step]),
+            bend: Bend::Reflect,
         });
         let limit = count.eye + count.shadow + self.ray_budget as u64;
         while let Some(b) = next.take().or_else(|| stack.pop()) {
@@ -323,8 +324,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 continue;
             };
             out.mix(index as u32 | b.depth << 16);
-            let object = &self.scene.objects()[index];
-            let (local, first, second) = self.scatter(&b, &hit, object, count, &mut out);
+            let (local, first, second) = self.scatter(&b, &hit, index, &mut trail, count, &mut out);
             out.radiance += local;
             // Continue with the heavier branch, keep the other for later (a different
             // depth from every branch already waiting, so the stack never overflows).
@@ -346,14 +346,23 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// How the caustic store gathers at the diffuse point `hit` reached by branch `b`:
     /// behind glass or a mirror, over the parallelogram spanned by the half-steps of
-    /// the branch's differentials there.
+    /// the branch's differentials there (replayed from the `trail`, and only where a
+    /// photon may lie within reach).
     #[inline]
-    fn gather(&self, b: &Branch, hit: &Hit) -> Gather {
+    fn gather(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
         match self.splats {
             None => Gather::Store,
             Some(_) if b.depth == 0 => Gather::Splatted,
+            Some(_) if !self.store.reaches(hit.point) => Gather::Dark,
             Some(_) => {
-                let at = b.diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
+                let scene = self.scene;
+                let diff = trail.differential(
+                    scene.camera(),
+                    scene.objects(),
+                    b.depth,
+                    (b.ray.dir, b.bend),
+                );
+                let at = diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
                 Gather::Footprint(Footprint {
                     a: at.dp[0] * 0.5,
                     b: at.dp[1] * 0.5,
@@ -369,30 +378,38 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         &self,
         b: &Branch,
         hit: &Hit,
-        object: &Object,
+        index: usize,
+        trail: &mut Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> (Rgb, Option<Branch>, Option<Branch>) {
+        let object = &self.scene.objects()[index];
         let d = b.ray.dir;
         let front = hit.front_face(d);
         let facing = if front { hit.normal } else { -hit.normal };
         let can_bounce = b.depth < self.max_depth;
         // Negligible throughput: not traced (see the module documentation).
         let traced = |w: Rgb| !w.is_black() && w.max_channel() >= self.cutoff;
-        let branch = |dir: UnitVec3, weight: Rgb, diff: Differential| Branch {
+        let branch = |dir: UnitVec3, weight: Rgb, bend: Bend| Branch {
             ray: Ray::spawn(hit, dir),
             weight,
             depth: b.depth + 1,
-            diff,
+            bend,
+        };
+        // The vertex the branches leave from, for their differentials.
+        let record = |trail: &mut Trail<DEPTH>, eta: f32| {
+            trail.record(b.depth, (d, b.bend), hit, index, eta);
         };
         match &object.material {
-            Material::Diffuse(m) if front => (self.diffuse(b, hit, m, count, log), None, None),
+            Material::Diffuse(m) if front => {
+                (self.diffuse(b, hit, m, trail, count, log), None, None)
+            }
             Material::Diffuse(_) => (Rgb::ZERO, None, None),
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
                 let reflected = traced(w).then(|| {
-                    let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
-                    branch(reflect(d, facing), w, turn.reflect())
+                    record(trail, 1.0);
+                    branch(reflect(d, facing), w, Bend::Reflect)
                 });
                 (Rgb::ZERO, reflected, None)
             }
@@ -404,19 +421,19 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 };
                 let eta = if front { 1.0 / g.ior } else { g.ior };
                 let i = interface(d, facing, eta);
-                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
+                record(trail, eta);
                 let w = weight * i.reflectance;
-                let reflected = traced(w).then(|| branch(reflect(d, facing), w, turn.reflect()));
+                let reflected = traced(w).then(|| branch(reflect(d, facing), w, Bend::Reflect));
                 let w = weight * ((1.0 - i.reflectance) * eta * eta);
                 let refracted = i
                     .refracted
                     .filter(|_| traced(w))
-                    .map(|t| branch(t, w, turn.refract(t, eta)));
+                    .map(|t| branch(t, w, Bend::Refract));
                 (Rgb::ZERO, reflected, refracted)
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(b, hit, c, -d, count, log)
+                    self.classic_local(b, hit, c, trail, count, log)
                 } else {
                     Rgb::ZERO
                 };
@@ -429,17 +446,17 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if !traced(wr + wt) {
                     return (b.weight * local, None, None);
                 }
-                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
+                record(trail, eta);
                 // Under total internal reflection the transmitted part follows the
                 // reflected ray: one ray carries both.
                 let (reflected, refracted) = match interface(d, facing, eta).refracted {
                     Some(t) => (
-                        traced(wr).then(|| branch(r, wr, turn.reflect())),
-                        traced(wt).then(|| branch(t, wt, turn.refract(t, eta))),
+                        traced(wr).then(|| branch(r, wr, Bend::Reflect)),
+                        traced(wt).then(|| branch(t, wt, Bend::Refract)),
                     ),
                     None => {
                         let w = wr + wt;
-                        (traced(w).then(|| branch(r, w, turn.reflect())), None)
+                        (traced(w).then(|| branch(r, w, Bend::Reflect)), None)
                     }
                 };
                 (b.weight * local, reflected, refracted)
@@ -457,13 +474,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         b: &Branch,
         hit: &Hit,
         m: &crate::material::Diffuse,
+        trail: &Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> Rgb {
-        let caustic = match self.gather(b, hit) {
+        let caustic = match self.gather(b, hit, trail) {
             Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
             Gather::Store => self.store.irradiance(hit.point, hit.normal),
-            Gather::Splatted => Rgb::ZERO,
+            Gather::Splatted | Gather::Dark => Rgb::ZERO,
         };
         let mut e = caustic;
         for light in self.scene.lights() {
@@ -478,17 +496,17 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         f * e * core::f32::consts::FRAC_1_PI
     }
 
-    /// The classic model's local part at a front-side hit seen from `to_eye`.
+    /// The classic model's local part at a front-side hit, seen along `b`.
     fn classic_local(
         &self,
         b: &Branch,
         hit: &Hit,
         c: &Classic,
-        to_eye: UnitVec3,
+        trail: &Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> Rgb {
-        let n = hit.normal;
+        let (n, to_eye) = (hit.normal, -b.ray.dir);
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
@@ -498,10 +516,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        let caustic = match self.gather(b, hit) {
+        let caustic = match self.gather(b, hit, trail) {
             Gather::Footprint(f) => self.store.classic_within(hit.point, n, to_eye, c, &f),
             Gather::Store => self.store.classic(hit.point, n, to_eye, c),
-            Gather::Splatted => Rgb::ZERO,
+            Gather::Splatted | Gather::Dark => Rgb::ZERO,
         };
         log.caustic += b.weight * caustic;
         ambient + lit + caustic
