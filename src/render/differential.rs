@@ -103,7 +103,7 @@ impl Turn {
     /// Transfers `diff`, of a ray along `d`, to its hit `t` along it on `shape`, of
     /// outward normal `normal` there; `front`: the ray arrived on the side `normal`
     /// points to.
-    #[inline(never)]
+    #[inline]
     pub fn at(
         diff: &Differential,
         d: UnitVec3,
@@ -130,13 +130,13 @@ impl Turn {
     }
 
     /// The mirror-reflected branch's differentials.
-    #[inline(never)]
+    #[inline]
     pub fn reflect(&self) -> Differential {
         self.at.reflect(self.d, self.n, self.dn)
     }
 
     /// The refracted branch's differentials, along `t`, with `eta = η_i/η_t`.
-    #[inline(never)]
+    #[inline]
     pub fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
         self.at.refract(self.d, t.get(), self.n, self.dn, eta)
     }
