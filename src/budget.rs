@@ -258,13 +258,21 @@ impl<const STORED: usize, const SPLATS: usize> DeviceMap<STORED, SPLATS> {
         KdTree::from_balanced(&self.photons[..self.len])
     }
 
-    /// The caustic store over this map, gathering up to `K` photons; an error when
-    /// `settings.k` exceeds `K`.
+    /// The caustic store over this map, gathering up to `K` photons, and stating that
+    /// it holds at most `STORED` (with `STORED ≤` [`FOOTPRINT_VISITS`](photon::FOOTPRINT_VISITS),
+    /// as in [`FIG6`], the footprint gather is one search); an error when `settings.k`
+    /// exceeds `K`.
     pub fn store<const K: usize>(
         &self,
         settings: &PhotonSettings,
-    ) -> Result<KdStore<'_, K>, Error> {
-        photon::store_over(self.tree(), self.unit, settings)
+    ) -> Result<KdStore<'_, K, STORED>, Error> {
+        let store: KdStore<'_, K> = photon::store_over(self.tree(), self.unit, settings)?;
+        // The tree is `photons[..len]`, and `len ≤ STORED`.
+        store.holding_at_most().ok_or(Error::Capacity {
+            what: "photons stored",
+            requested: self.len,
+            capacity: STORED,
+        })
     }
 }
 

@@ -157,9 +157,12 @@ impl Region {
 
 /// A kd-tree photon map used as a caustic store, gathering up to `K` photons
 /// (the compiled capacity of the gather; `k ≤ K` photons are used), or every photon
-/// within a fixed radius.
+/// within a fixed radius. `N` bounds the photons the map holds (a device map's
+/// capacity, [`holding_at_most`](Self::holding_at_most); unbounded by default): with
+/// `N ≤` [`FOOTPRINT_VISITS`] one search always covers a footprint, so the cut into
+/// segments, the coarse levels and the scaling are not compiled.
 #[derive(Clone, Copy, Debug)]
-pub struct KdStore<'a, const K: usize> {
+pub struct KdStore<'a, const K: usize, const N: usize = { usize::MAX }> {
     tree: KdTree<'a>,
     /// Power of one unit of stored photon power, W.
     unit: f32,
@@ -183,7 +186,7 @@ pub const THINNING: usize = 16;
 /// scaled down about its centre.
 pub const FOOTPRINT_VISITS: usize = 1024;
 
-impl<'a, const K: usize> KdStore<'a, K> {
+impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
     /// A store over a balanced tree whose photon powers are in units of `unit` W,
     /// gathering the `k` nearest photons (clamped to `1..=K`) within `max_radius`, or,
     /// with `k = None`, every photon within `max_radius` (the fixed-radius gather of
@@ -204,6 +207,20 @@ impl<'a, const K: usize> KdStore<'a, K> {
             bounds: bounds(tree.photons()),
             coarse: [None; 2],
         }
+    }
+
+    /// The same store, stating that its map holds at most `M` photons; `None` when it
+    /// holds more.
+    pub fn holding_at_most<const M: usize>(self) -> Option<KdStore<'a, K, M>> {
+        (self.tree.photons().len() <= M).then_some(KdStore {
+            tree: self.tree,
+            unit: self.unit,
+            k: self.k,
+            max_radius2: self.max_radius2,
+            cone: self.cone,
+            bounds: self.bounds,
+            coarse: self.coarse,
+        })
     }
 
     /// The same store with coarse levels for large footprints: `level1` holds every
@@ -323,6 +340,12 @@ impl<'a, const K: usize> KdStore<'a, K> {
         if self.out_of_reach(x) {
             return Some((Rgb::ZERO, region.area));
         }
+        if N <= FOOTPRINT_VISITS {
+            // No search can visit more photons than the map holds: the first always
+            // completes (the loop below would return the same sum at once).
+            let (sum, _) = self.sum_in(Some(self.tree), x, n, &region, false, weight);
+            return Some((sum * self.unit, region.area));
+        }
         // The finest level where the footprint visits at most FOOTPRINT_VISITS
         // photons: a search that would visit more stops there and is tried again — a
         // sliver cut into disks, then on the next coarser level, at last scaled down.
@@ -426,7 +449,7 @@ fn bounds(photons: &[Photon]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
-impl<const K: usize> CausticStore for KdStore<'_, K> {
+impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
     /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons, `r` the distance to
     /// the k-th (or the maximum radius when fewer are found): Jensen 2001, eq. 7.6,
     /// divided by the diffuse BRDF.
