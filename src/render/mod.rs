@@ -156,6 +156,27 @@ struct Branch {
     bend: Bend,
 }
 
+/// A branch a specular hit spawns, before it is placed: its direction, weight and bend.
+#[derive(Clone, Copy, Debug)]
+struct Child {
+    dir: UnitVec3,
+    weight: Rgb,
+    bend: Bend,
+}
+
+impl Child {
+    /// The branch, from `hit`, at `depth`.
+    #[inline]
+    fn branch(self, hit: &Hit, depth: u32) -> Branch {
+        Branch {
+            ray: Ray::spawn(hit, self.dir),
+            weight: self.weight,
+            depth,
+            bend: self.bend,
+        }
+    }
+}
+
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
 /// which objects, in which order, and which lights were visible at each shaded point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -306,40 +327,51 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
         let mut trail = Trail::new(1.0 / m.max(1) as f32);
-        let mut next = Some(Branch {
+        let mut b = Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
             bend: Bend::Reflect,
-        });
+        };
         let limit = count.eye + count.shadow + self.ray_budget as u64;
-        while let Some(b) = next.take().or_else(|| stack.pop()) {
+        loop {
             if count.eye + count.shadow + self.rays_per_hit as u64 > limit {
                 break; // the budget is spent: drop this and every pending branch
             }
             count.eye += 1;
-            let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
+            if let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) {
+                out.mix(index as u32 | b.depth << 16);
+                let (local, [first, second]) =
+                    self.scatter(&b, &hit, index, &mut trail, count, &mut out);
+                out.radiance += local;
+                // Continue with the heavier branch, keep the other for later (a
+                // different depth from every branch already waiting, so the stack never
+                // overflows). Each is made where it goes, not moved there.
+                let sum =
+                    |c: &Option<Child>| c.map_or(0.0, |c| c.weight.r + c.weight.g + c.weight.b);
+                let (heavier, lighter) = if sum(&second) > sum(&first) {
+                    (second, first)
+                } else {
+                    (first, second)
+                };
+                let depth = b.depth + 1;
+                if let Some(c) = lighter {
+                    if stack.push(c.branch(&hit, depth)).is_err() {
+                        debug_assert!(false, "path stack overflow: DEPTH < max_depth");
+                    }
+                }
+                if let Some(c) = heavier {
+                    b = c.branch(&hit, depth);
+                    continue;
+                }
+            } else {
                 out.mix(u32::MAX);
                 out.radiance += b.weight * self.scene.background();
-                continue;
-            };
-            out.mix(index as u32 | b.depth << 16);
-            let (local, first, second) = self.scatter(&b, &hit, index, &mut trail, count, &mut out);
-            out.radiance += local;
-            // Continue with the heavier branch, keep the other for later (a different
-            // depth from every branch already waiting, so the stack never overflows).
-            let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
-            let (heavier, lighter) = if sum(&second) > sum(&first) {
-                (second, first)
-            } else {
-                (first, second)
-            };
-            if let Some(s) = lighter {
-                if stack.push(s).is_err() {
-                    debug_assert!(false, "path stack overflow: DEPTH < max_depth");
-                }
             }
-            next = heavier;
+            match stack.pop() {
+                Some(pending) => b = pending,
+                None => break,
+            }
         }
         out
     }
@@ -371,7 +403,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
     }
 
-    /// Light leaving `hit` towards the eye directly, and up to two specular branches;
+    /// Light leaving `hit` towards the eye directly, and up to two specular branches
+    /// (reflected, refracted);
     /// the caustic part and the path's events go to `log`.
     #[inline]
     fn scatter(
@@ -382,7 +415,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         trail: &mut Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
-    ) -> (Rgb, Option<Branch>, Option<Branch>) {
+    ) -> (Rgb, [Option<Child>; 2]) {
         let object = &self.scene.objects()[index];
         let d = b.ray.dir;
         let front = hit.front_face(d);
@@ -390,28 +423,23 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let can_bounce = b.depth < self.max_depth;
         // Negligible throughput: not traced (see the module documentation).
         let traced = |w: Rgb| !w.is_black() && w.max_channel() >= self.cutoff;
-        let branch = |dir: UnitVec3, weight: Rgb, bend: Bend| Branch {
-            ray: Ray::spawn(hit, dir),
-            weight,
-            depth: b.depth + 1,
-            bend,
-        };
+        let branch = |dir: UnitVec3, weight: Rgb, bend: Bend| Child { dir, weight, bend };
         // The vertex the branches leave from, for their differentials.
         let record = |trail: &mut Trail<DEPTH>, eta: f32| {
             trail.record(b.depth, (d, b.bend), hit, index, eta);
         };
         match &object.material {
             Material::Diffuse(m) if front => {
-                (self.diffuse(b, hit, m, trail, count, log), None, None)
+                (self.diffuse(b, hit, m, trail, count, log), [None, None])
             }
-            Material::Diffuse(_) => (Rgb::ZERO, None, None),
+            Material::Diffuse(_) => (Rgb::ZERO, [None, None]),
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
                 let reflected = traced(w).then(|| {
                     record(trail, 1.0);
                     branch(reflect(d, facing), w, Bend::Reflect)
                 });
-                (Rgb::ZERO, reflected, None)
+                (Rgb::ZERO, [reflected, None])
             }
             Material::Dielectric(g) if can_bounce => {
                 let weight = if front {
@@ -429,7 +457,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     .refracted
                     .filter(|_| traced(w))
                     .map(|t| branch(t, w, Bend::Refract));
-                (Rgb::ZERO, reflected, refracted)
+                (Rgb::ZERO, [reflected, refracted])
             }
             Material::Classic(c) => {
                 let local = if front {
@@ -438,13 +466,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     Rgb::ZERO
                 };
                 if !can_bounce {
-                    return (b.weight * local, None, None);
+                    return (b.weight * local, [None, None]);
                 }
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
                 let (wr, wt) = (b.weight * c.reflectivity, b.weight * c.transparency);
                 if !traced(wr + wt) {
-                    return (b.weight * local, None, None);
+                    return (b.weight * local, [None, None]);
                 }
                 record(trail, eta);
                 // Under total internal reflection the transmitted part follows the
@@ -459,10 +487,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                         (traced(w).then(|| branch(r, w, Bend::Reflect)), None)
                     }
                 };
-                (b.weight * local, reflected, refracted)
+                (b.weight * local, [reflected, refracted])
             }
             // A specular surface after max_depth interactions contributes nothing.
-            Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, None, None),
+            Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, [None, None]),
         }
     }
 
