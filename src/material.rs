@@ -167,7 +167,7 @@ impl Classic {
     /// `(max(n·l, 0)·k_d·color + max(n·h, 0)^a·k_s·color)`, with `l` the direction
     /// towards the light (the negated photon direction) and `h` the half vector of `l`
     /// and the direction towards the eye.
-    #[inline]
+    #[inline(never)]
     pub fn kernel(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
         let cos_l = max_num(n.dot(to_light.get()), 0.0);
         let spec = match UnitVec3::new(to_light.get() + to_eye.get()) {

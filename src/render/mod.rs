@@ -380,27 +380,34 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// behind glass or a mirror, over the parallelogram spanned by the half-steps of
     /// the branch's differentials there (replayed from the `trail`, and only where a
     /// photon may lie within reach).
-    #[inline]
+    #[inline(always)]
     fn gather(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
         match self.splats {
             None => Gather::Store,
             Some(_) if b.depth == 0 => Gather::Splatted,
-            Some(_) if !self.store.reaches(hit.point) => Gather::Dark,
-            Some(_) => {
-                let scene = self.scene;
-                let diff = trail.differential(
-                    scene.camera(),
-                    scene.objects(),
-                    b.depth,
-                    (b.ray.dir, b.bend),
-                );
-                let at = diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
-                Gather::Footprint(Footprint {
-                    a: at.dp[0] * 0.5,
-                    b: at.dp[1] * 0.5,
-                })
-            }
+            Some(_) => self.behind(b, hit, trail),
         }
+    }
+
+    /// The gather at `hit` seen through glass or in a mirror along `b`: over the
+    /// half-steps of its differentials there, where a photon may lie within reach.
+    #[inline(never)]
+    fn behind(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
+        if !self.store.reaches(hit.point) {
+            return Gather::Dark;
+        }
+        let scene = self.scene;
+        let diff = trail.differential(
+            scene.camera(),
+            scene.objects(),
+            b.depth,
+            (b.ray.dir, b.bend),
+        );
+        let at = diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
+        Gather::Footprint(Footprint {
+            a: at.dp[0] * 0.5,
+            b: at.dp[1] * 0.5,
+        })
     }
 
     /// Light leaving `hit` towards the eye directly, and up to two specular branches
