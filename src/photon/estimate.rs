@@ -337,14 +337,16 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> Option<(Rgb, f32)> {
         let region = Region::new(footprint, self.max_radius2)?;
-        if self.out_of_reach(x) {
-            return Some((Rgb::ZERO, region.area));
-        }
         if N <= FOOTPRINT_VISITS {
             // No search can visit more photons than the map holds: the first always
-            // completes (the loop below would return the same sum at once).
+            // completes (the loop below would return the same sum at once). No reach
+            // test either: the renderer asks `reaches` first, and a search out of
+            // reach finds nothing, the same zero.
             let (sum, _) = self.sum_in(Some(self.tree), x, n, &region, false, weight);
             return Some((sum * self.unit, region.area));
+        }
+        if self.out_of_reach(x) {
+            return Some((Rgb::ZERO, region.area));
         }
         // The finest level where the footprint visits at most FOOTPRINT_VISITS
         // photons: a search that would visit more stops there and is tried again — a

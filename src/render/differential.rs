@@ -22,81 +22,70 @@ use crate::geometry::{Hit, Shape};
 use crate::math::{UnitVec3, Vec3};
 use crate::scene::Object;
 
-/// The derivatives of a ray's origin and direction along the image's x and y, per step
-/// of the sample's extent on the image (a pixel, or a sub-pixel of a grid).
+/// The derivatives of a ray's origin and direction along one of the image's axes (x
+/// or y), per step of the sample's extent on the image (a pixel, or a sub-pixel of a
+/// grid). The two axes never mix, so each is carried on its own: one copy of the code.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Differential {
-    /// `∂P/∂x`, `∂P/∂y`.
-    pub dp: [Vec3; 2],
-    /// `∂D/∂x`, `∂D/∂y`.
-    pub dd: [Vec3; 2],
+    /// `∂P`.
+    pub dp: Vec3,
+    /// `∂D`.
+    pub dd: Vec3,
 }
 
 impl Differential {
     /// A pinhole camera ray: the origin is fixed, the direction turns by `dd`.
     #[inline]
-    pub fn camera(dd: [Vec3; 2]) -> Self {
-        Self {
-            dp: [Vec3::ZERO; 2],
-            dd,
-        }
+    pub fn camera(dd: Vec3) -> Self {
+        Self { dp: Vec3::ZERO, dd }
     }
 
-    /// The differentials at a hit `t` along direction `d`, on a surface of normal `n`
-    /// (either orientation): the direction's are unchanged.
+    /// The differential at a hit `t` along direction `d`, on a surface of normal `n`
+    /// (either orientation): the direction's is unchanged.
     #[inline]
     pub fn transfer(&self, d: Vec3, t: f32, n: Vec3) -> Self {
         let dn = d.dot(n);
-        let dp = |i: usize| {
-            let moved = self.dp[i] + self.dd[i] * t;
-            moved - d * (moved.dot(n) / dn)
-        };
+        let moved = self.dp + self.dd * t;
         Self {
-            dp: [dp(0), dp(1)],
+            dp: moved - d * (moved.dot(n) / dn),
             dd: self.dd,
         }
     }
 
     /// The reflected ray's, about the normal `n` facing `d` that turns by `dn`.
     #[inline]
-    pub fn reflect(&self, d: Vec3, n: Vec3, dn: [Vec3; 2]) -> Self {
+    pub fn reflect(&self, d: Vec3, n: Vec3, dn: Vec3) -> Self {
         let d_n = d.dot(n);
-        let dd = |i: usize| {
-            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
-            self.dd[i] - (dn[i] * d_n + n * dd_n) * 2.0
-        };
+        let dd_n = self.dd.dot(n) + d.dot(dn);
         Self {
             dp: self.dp,
-            dd: [dd(0), dd(1)],
+            dd: self.dd - (dn * d_n + n * dd_n) * 2.0,
         }
     }
 
     /// The refracted ray's (direction `t_dir`), about the normal `n` facing `d` that
     /// turns by `dn`, with `eta = η_i/η_t`.
     #[inline]
-    pub fn refract(&self, d: Vec3, t_dir: Vec3, n: Vec3, dn: [Vec3; 2], eta: f32) -> Self {
+    pub fn refract(&self, d: Vec3, t_dir: Vec3, n: Vec3, dn: Vec3, eta: f32) -> Self {
         let (d_n, t_n) = (d.dot(n), t_dir.dot(n));
         let mu = eta * d_n - t_n;
         let dmu_per = eta - eta * eta * d_n / t_n;
-        let dd = |i: usize| {
-            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
-            self.dd[i] * eta - (dn[i] * mu + n * (dmu_per * dd_n))
-        };
+        let dd_n = self.dd.dot(n) + d.dot(dn);
         Self {
             dp: self.dp,
-            dd: [dd(0), dd(1)],
+            dd: self.dd * eta - (dn * mu + n * (dmu_per * dd_n)),
         }
     }
 }
 
-/// A branch's differentials transferred to a specular hit, with the normal facing the
-/// ray and that normal's turn across the sample: what the reflected and refracted
-/// branches' differentials are made from.
+/// A branch's differential transferred to a specular hit, with the normal facing the
+/// ray and that normal's turn along the same image axis: what the reflected and
+/// refracted branches' differentials are made from.
 pub(crate) struct Turn {
     at: Differential,
     d: Vec3,
     n: Vec3,
-    dn: [Vec3; 2],
+    dn: Vec3,
 }
 
 impl Turn {
@@ -120,12 +109,11 @@ impl Turn {
         } else {
             (-normal, -1.0)
         };
-        let turn = |i: usize| shape.normal_derivative(normal, at.dp[i]) * sign;
         Self {
             at,
             d,
             n: facing.get(),
-            dn: [turn(0), turn(1)],
+            dn: shape.normal_derivative(normal, at.dp) * sign,
         }
     }
 
@@ -198,7 +186,7 @@ impl<const DEPTH: usize> Trail<DEPTH> {
 
     /// Records the specular hit of a branch at `depth` that arrived along `d` by `bend`,
     /// on `object` (the scene's index); `eta` for its refracted branch.
-    #[inline]
+    #[inline(never)]
     pub fn record(
         &mut self,
         depth: u32,
@@ -222,8 +210,9 @@ impl<const DEPTH: usize> Trail<DEPTH> {
         }
     }
 
-    /// The differentials of the branch at `depth` that left its last vertex along `dir`
-    /// by `bend`: the camera's, carried through the first `depth` vertices.
+    /// The differential along the image's `axis` (0: x, 1: y) of the branch at `depth`
+    /// that left its last vertex along `dir` by `bend`: the camera's, carried through
+    /// the first `depth` vertices.
     #[inline(never)]
     pub fn differential(
         &self,
@@ -231,11 +220,12 @@ impl<const DEPTH: usize> Trail<DEPTH> {
         objects: &[Object],
         depth: u32,
         (dir, bend): (UnitVec3, Bend),
+        axis: usize,
     ) -> Differential {
         let path = &self.vertices[..(depth as usize).min(self.vertices.len())];
         let root = path.first().map_or(dir, |v| v.d);
-        let [dx, dy] = camera.direction_derivatives(root);
-        let mut diff = Differential::camera([dx * self.step, dy * self.step]);
+        let dd = camera.direction_derivatives(root)[axis & 1];
+        let mut diff = Differential::camera(dd * self.step);
         for (k, v) in path.iter().enumerate() {
             let (out, bend) = path
                 .get(k + 1)
@@ -264,32 +254,30 @@ mod tests {
     /// or totally reflects.
     fn follow(
         ray: Ray,
-        diff: Differential,
+        diff: [Differential; 2],
         specular: &[(Shape, bool)],
         floor: &Shape,
-    ) -> Option<(Vec3, Differential)> {
+    ) -> Option<(Vec3, [Differential; 2])> {
         let (mut ray, mut diff) = (ray, diff);
         for (shape, mirror) in specular {
             let hit = shape.intersect(&ray, f32::INFINITY)?;
             let d = ray.dir;
             let front = hit.front_face(d);
             let facing = if front { hit.normal } else { -hit.normal };
-            let turn = Turn::at(&diff, d, (hit.t, hit.normal), shape, front);
+            let turn = |diff: &Differential| Turn::at(diff, d, (hit.t, hit.normal), shape, front);
             let (dir, next) = if *mirror {
-                (reflect(d, facing), turn.reflect())
+                (reflect(d, facing), diff.map(|a| turn(&a).reflect()))
             } else {
                 let eta = if front { 1.0 / 1.5 } else { 1.5 };
                 let t = interface(d, facing, eta).refracted?;
-                (t, turn.refract(t, eta))
+                (t, diff.map(|a| turn(&a).refract(t, eta)))
             };
             ray = Ray::spawn(&hit, dir);
             diff = next;
         }
         let hit = floor.intersect(&ray, f32::INFINITY)?;
-        Some((
-            hit.point,
-            diff.transfer(ray.dir.get(), hit.t, hit.normal.get()),
-        ))
+        let at = |a: Differential| a.transfer(ray.dir.get(), hit.t, hit.normal.get());
+        Some((hit.point, diff.map(at)))
     }
 
     /// The differentials carried through curved glass (into and out of a sphere, of a
@@ -318,7 +306,9 @@ mod tests {
                 for px in (4..320).step_by(8) {
                     let at = |x: f32, y: f32| camera.ray_at(px, py, x, y);
                     let ray = at(0.5, 0.5);
-                    let diff = Differential::camera(camera.direction_derivatives(ray.dir));
+                    let diff = camera
+                        .direction_derivatives(ray.dir)
+                        .map(Differential::camera);
                     let Some((_, d)) = follow(ray, diff, specular, target) else {
                         continue;
                     };
@@ -330,7 +320,7 @@ mod tests {
                             continue;
                         };
                         let fd = (plus - minus) / (2.0 * h);
-                        errors.push((fd - d.dp[i]).length() / fd.length());
+                        errors.push((fd - d[i].dp).length() / fd.length());
                     }
                 }
             }

@@ -396,17 +396,15 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         if !self.store.reaches(hit.point) {
             return Gather::Dark;
         }
-        let scene = self.scene;
-        let diff = trail.differential(
-            scene.camera(),
-            scene.objects(),
-            b.depth,
-            (b.ray.dir, b.bend),
-        );
-        let at = diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
+        let (camera, objects) = (self.scene.camera(), self.scene.objects());
+        // Each image axis on its own (they never mix).
+        let half = |axis: usize| {
+            let diff = trail.differential(camera, objects, b.depth, (b.ray.dir, b.bend), axis);
+            diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5
+        };
         Gather::Footprint(Footprint {
-            a: at.dp[0] * 0.5,
-            b: at.dp[1] * 0.5,
+            a: half(0),
+            b: half(1),
         })
     }
 
