@@ -222,7 +222,7 @@ pub struct Interface {
 /// `F = ½(r_s² + r_p²)` with `r_s = (η_i cos_i − η_t cos_t)/(η_i cos_i + η_t cos_t)`,
 /// `r_p = (η_t cos_i − η_i cos_t)/(η_t cos_i + η_i cos_t)` (Born & Wolf; pbrt-v4 §9.5).
 /// Both denominators are positive whenever `cos²t > 0`, so `F` is never NaN.
-#[inline]
+#[inline(never)]
 pub fn interface(d: UnitVec3, n: UnitVec3, eta: f32) -> Interface {
     let cos_i = (-n.dot(d.get())).clamp(0.0, 1.0);
     let eta_cos_i = eta * cos_i;

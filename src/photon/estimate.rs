@@ -371,7 +371,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// The weighted sum of the front-side photons of `tree` inside `region` and the
     /// photons visited; `None` visits when they would exceed [`FOOTPRINT_VISITS`].
-    #[inline(never)]
+    #[inline]
     fn sum_in(
         &self,
         tree: Option<KdTree<'_>>,
