@@ -426,8 +426,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let front = hit.front_face(d);
         let facing = if front { hit.normal } else { -hit.normal };
         let can_bounce = b.depth < self.max_depth;
-        // Negligible throughput: not traced (see the module documentation).
-        let traced = |w: Rgb| !w.is_black() && w.max_channel() >= self.cutoff;
+        // Negligible throughput: not traced (see the module documentation). The
+        // largest channel (NaN only when all are) is positive exactly when the weight
+        // is not black.
+        let traced = |w: Rgb| {
+            let m = w.max_channel();
+            m > 0.0 && m >= self.cutoff
+        };
         let branch = |dir: UnitVec3, weight: Rgb, bend: Bend| Child { dir, weight, bend };
         // The vertex the branches leave from, for their differentials.
         let record = |trail: &mut Trail<DEPTH>, eta: f32| {
