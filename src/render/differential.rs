@@ -340,4 +340,70 @@ mod tests {
             );
         }
     }
+
+    /// A branch of an eye path: its ray, depth, how it left its vertex, and the
+    /// differentials carried to it.
+    type Pending = (Ray, u32, Bend, [Differential; 2]);
+
+    /// Replaying the trail gives, bit for bit, the differentials carried through every
+    /// vertex, at every hit of every branch of a path tree walked depth first as the
+    /// renderer walks it (a branch waits on a stack while its sibling records deeper
+    /// vertices, then records its own over them): through the glass sphere and off the
+    /// mirror of the device's glass scene, both image axes, a 2×2 grid's sub-pixel.
+    #[test]
+    fn the_trail_replays_the_carried_differentials_bit_for_bit() {
+        use crate::material::Material;
+        let scene = crate::demo::glass::<4, 1>(320, 240).unwrap();
+        let (camera, objects) = (scene.camera(), scene.objects());
+        let step = 0.5;
+        let (mut checked, mut overwritten) = (0, 0);
+        for py in (2..240).step_by(5) {
+            for px in (2..320).step_by(5) {
+                let ray = camera.ray_at(px, py, 0.25, 0.75);
+                let dd = camera.direction_derivatives(ray.dir);
+                let carried = dd.map(|d| Differential::camera(d * step));
+                let mut trail = Trail::<4>::new(step);
+                let mut stack: std::vec::Vec<Pending> = std::vec![(ray, 0, Bend::Reflect, carried)];
+                while let Some((ray, depth, bend, carried)) = stack.pop() {
+                    let Some((hit, index)) = scene.intersect(&ray, f32::INFINITY) else {
+                        continue;
+                    };
+                    let d = ray.dir;
+                    for (axis, want) in carried.iter().enumerate().filter(|_| depth > 0) {
+                        let replayed = trail.differential(camera, objects, depth, (d, bend), axis);
+                        assert_eq!(replayed, *want, "depth {depth}, axis {axis}");
+                        checked += 1;
+                    }
+                    let front = hit.front_face(d);
+                    let facing = if front { hit.normal } else { -hit.normal };
+                    let eta = match objects[index].material {
+                        Material::Dielectric(g) if front => 1.0 / g.ior,
+                        Material::Dielectric(g) => g.ior,
+                        Material::Mirror(_) => 1.0,
+                        _ => continue,
+                    };
+                    if depth == 3 {
+                        continue;
+                    }
+                    overwritten += usize::from(trail.vertices.len() > depth as usize);
+                    trail.record(depth, (d, bend), &hit, index, eta);
+                    let shape = &objects[index].shape;
+                    let turn = |a: &Differential| Turn::at(a, d, (hit.t, hit.normal), shape, front);
+                    let reflected = carried.map(|a| turn(&a).reflect());
+                    let r = Ray::spawn(&hit, reflect(d, facing));
+                    stack.push((r, depth + 1, Bend::Reflect, reflected));
+                    if let Material::Dielectric(_) = objects[index].material {
+                        if let Some(t) = interface(d, facing, eta).refracted {
+                            let bent = carried.map(|a| turn(&a).refract(t, eta));
+                            stack.push((Ray::spawn(&hit, t), depth + 1, Bend::Refract, bent));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            checked >= 1000 && overwritten >= 10,
+            "{checked}, {overwritten}"
+        );
+    }
 }
