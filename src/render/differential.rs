@@ -2,7 +2,10 @@
 //! (Igehy 1999, "Tracing Ray Differentials"; pbrt-v4 §10.1), carried through every
 //! mirror reflection and refraction so that a diffuse point seen through glass knows
 //! the patch of surface its pixel covers there — magnified by a ball, stretched along
-//! one axis by a tube — and the caustic store averages over exactly that patch.
+//! one axis by a tube — and the caustic store averages over exactly that patch. They
+//! are not stored with each branch: the path's specular vertices are ([`Trail`]), and
+//! a gather replays the recurrences below through them, the same operations on the
+//! same values as carrying them along.
 //!
 //! With `D` the unit direction, `N` the normal facing the ray (`D·N < 0`) and `∂` a
 //! derivative along the image's x or y:

@@ -20,8 +20,11 @@
 //! surface the sample stands for: the parallelogram its ray differentials span there
 //! (Igehy 1999, carried through every reflection and refraction: magnified by a ball,
 //! stretched by a tube), bounded by the store's own radius — the pixel's box filter
-//! under the differentials' linearisation ([`Footprint`]). Without splats the store
-//! gathers at every diffuse hit, as in the paper.
+//! under the differentials' linearisation ([`Footprint`]). The path records its
+//! specular vertices and the differentials are worked out from them only at such a
+//! gather, and only where a photon may lie within reach ([`CausticStore::reaches`]):
+//! most branches never need them. Without splats the store gathers at every diffuse
+//! hit, as in the paper.
 //!
 //! A pixel's value is the average radiance over its area (box filter). The default
 //! [`Sampling::Adaptive`] traces the pixel's four corners (Whitted 1980's adaptive
