@@ -213,34 +213,35 @@ impl<const DEPTH: usize> Trail<DEPTH> {
         }
     }
 
-    /// The differential along the image's `axis` (0: x, 1: y) of the branch at `depth`
-    /// that left its last vertex along `dir` by `bend`: the camera's, carried through
-    /// the first `depth` vertices.
+    /// The differentials along the image's x and y of the branch at `depth` that left
+    /// its last vertex along `dir` by `bend`: the camera's, carried through the first
+    /// `depth` vertices (the two axes side by side, one copy of the code for both).
     #[inline(never)]
-    pub fn differential(
+    pub fn differentials(
         &self,
         camera: &Camera,
         objects: &[Object],
         depth: u32,
         (dir, bend): (UnitVec3, Bend),
-        axis: usize,
-    ) -> Differential {
+    ) -> [Differential; 2] {
         let path = &self.vertices[..(depth as usize).min(self.vertices.len())];
         let root = path.first().map_or(dir, |v| v.d);
-        let dd = camera.direction_derivatives(root)[axis & 1];
-        let mut diff = Differential::camera(dd * self.step);
+        let dd = camera.direction_derivatives(root);
+        let mut diffs = dd.map(|dd| Differential::camera(dd * self.step));
         for (k, v) in path.iter().enumerate() {
             let (out, bend) = path
                 .get(k + 1)
                 .map_or((dir, bend), |next| (next.d, next.bend));
             let shape = &objects[v.object].shape;
-            let turn = Turn::at(&diff, v.d, (v.t, v.normal), shape, v.front);
-            diff = match bend {
-                Bend::Reflect => turn.reflect(),
-                Bend::Refract => turn.refract(out, v.eta),
-            };
+            for diff in &mut diffs {
+                let turn = Turn::at(diff, v.d, (v.t, v.normal), shape, v.front);
+                *diff = match bend {
+                    Bend::Reflect => turn.reflect(),
+                    Bend::Refract => turn.refract(out, v.eta),
+                };
+            }
         }
-        diff
+        diffs
     }
 }
 
@@ -372,9 +373,9 @@ mod tests {
                         continue;
                     };
                     let d = ray.dir;
-                    for (axis, want) in carried.iter().enumerate().filter(|_| depth > 0) {
-                        let replayed = trail.differential(camera, objects, depth, (d, bend), axis);
-                        assert_eq!(replayed, *want, "depth {depth}, axis {axis}");
+                    if depth > 0 {
+                        let replayed = trail.differentials(camera, objects, depth, (d, bend));
+                        assert_eq!(replayed, carried, "depth {depth}");
                         checked += 1;
                     }
                     let front = hit.front_face(d);

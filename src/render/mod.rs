@@ -400,15 +400,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             return Gather::Dark;
         }
         let (camera, objects) = (self.scene.camera(), self.scene.objects());
-        // Each image axis on its own (they never mix).
-        let half = |axis: usize| {
-            let diff = trail.differential(camera, objects, b.depth, (b.ray.dir, b.bend), axis);
-            diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5
-        };
-        Gather::Footprint(Footprint {
-            a: half(0),
-            b: half(1),
-        })
+        let diffs = trail.differentials(camera, objects, b.depth, (b.ray.dir, b.bend));
+        let [a, b] =
+            diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
+        Gather::Footprint(Footprint { a, b })
     }
 
     /// Light leaving `hit` towards the eye directly, and up to two specular branches
