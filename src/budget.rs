@@ -258,13 +258,21 @@ impl<const STORED: usize, const SPLATS: usize> DeviceMap<STORED, SPLATS> {
         KdTree::from_balanced(&self.photons[..self.len])
     }
 
-    /// The caustic store over this map, gathering up to `K` photons; an error when
-    /// `settings.k` exceeds `K`.
+    /// The caustic store over this map, gathering up to `K` photons, and stating that
+    /// it holds at most `STORED` (with `STORED ≤` [`FOOTPRINT_VISITS`](photon::FOOTPRINT_VISITS),
+    /// as in [`FIG6`], the footprint gather is one search); an error when `settings.k`
+    /// exceeds `K`.
     pub fn store<const K: usize>(
         &self,
         settings: &PhotonSettings,
-    ) -> Result<KdStore<'_, K>, Error> {
-        photon::store_over(self.tree(), self.unit, settings)
+    ) -> Result<KdStore<'_, K, STORED>, Error> {
+        let store: KdStore<'_, K> = photon::store_over(self.tree(), self.unit, settings)?;
+        // The tree is `photons[..len]`, and `len ≤ STORED`.
+        store.holding_at_most().ok_or(Error::Capacity {
+            what: "photons stored",
+            requested: self.len,
+            capacity: STORED,
+        })
     }
 }
 
@@ -352,6 +360,53 @@ mod tests {
             "{}",
             a.stored
         );
+    }
+
+    /// The device's store (its map's capacity stated, `FIG6.stored ≤ FOOTPRINT_VISITS`:
+    /// one search per footprint, no reach test) gathers, bit for bit, what the desktop's
+    /// store over the same tree gathers (the chain of segments and levels), for
+    /// footprints from a hair to past the gather radius, square and slivers along
+    /// either axis, at every stored photon of the field and beyond the photons' reach;
+    /// and a store that holds more than it states is refused.
+    #[test]
+    fn the_capped_store_gathers_the_footprints_the_desktop_store_gathers() {
+        use crate::material::Classic;
+        use crate::math::{Rgb, UnitVec3, Vec3};
+        use crate::photon::Footprint;
+        let scene = demo::fig6::<FIG6_OBJECTS, FIG6_LIGHTS>(16, 12).unwrap();
+        let settings = FIG6.settings().unwrap();
+        let mut map: DeviceMap<{ FIG6.stored }, { FIG6.splats }> = DeviceMap::new();
+        map.build(&scene, &settings, FIG6.seed).unwrap();
+        let capped: KdStore<'_, { FIG6.k }, { FIG6.stored }> = map.store(&settings).unwrap();
+        let free: KdStore<'_, { FIG6.k }> =
+            photon::store_over(map.tree(), map.unit, &settings).unwrap();
+        assert!(free.holding_at_most::<{ FIG6.stored }>().is_some());
+        assert!(free.holding_at_most::<16>().is_none());
+        let classic = Classic::new(Rgb::ONE, 0.7, 0.2, 0.8, 20.0, 0.0, 0.0, 1.0);
+        let (up, eye) = (
+            UnitVec3::Y,
+            UnitVec3::new(Vec3::new(0.3, 1.0, 0.5)).unwrap(),
+        );
+        let mut lit = 0;
+        let far = [Vec3::new(40.0, -5.0, 0.0)];
+        let points = map.tree().photons().iter().map(|p| p.position()).chain(far);
+        for (i, x) in points.enumerate() {
+            let s = [1e-3, 0.05, 0.3, 0.9, 3.0][i % 5];
+            let sliver = [1.0, 1.0, 8.0, 0.125, 40.0][i / 5 % 5];
+            let f = Footprint {
+                a: Vec3::new(s, 0.0, 0.1 * s),
+                b: Vec3::new(-0.1 * s, 0.0, s * sliver),
+            };
+            let (e, c) = (
+                capped.irradiance_within(x, up, &f),
+                free.irradiance_within(x, up, &f),
+            );
+            assert_eq!(e, c, "irradiance at {x}, footprint {f:?}");
+            lit += usize::from(!e.total.is_black());
+            let k = |s: &dyn CausticStore| s.classic_within(x, up, eye, &classic, &f);
+            assert_eq!(k(&capped), k(&free), "classic at {x}, footprint {f:?}");
+        }
+        assert!(lit > 100, "{lit}");
     }
 
     #[test]

@@ -167,7 +167,7 @@ impl Classic {
     /// `(max(n·l, 0)·k_d·color + max(n·h, 0)^a·k_s·color)`, with `l` the direction
     /// towards the light (the negated photon direction) and `h` the half vector of `l`
     /// and the direction towards the eye.
-    #[inline]
+    #[inline(never)]
     pub fn kernel(&self, n: UnitVec3, to_light: UnitVec3, to_eye: UnitVec3) -> Rgb {
         let cos_l = max_num(n.dot(to_light.get()), 0.0);
         let spec = match UnitVec3::new(to_light.get() + to_eye.get()) {
@@ -222,7 +222,7 @@ pub struct Interface {
 /// `F = ½(r_s² + r_p²)` with `r_s = (η_i cos_i − η_t cos_t)/(η_i cos_i + η_t cos_t)`,
 /// `r_p = (η_t cos_i − η_i cos_t)/(η_t cos_i + η_i cos_t)` (Born & Wolf; pbrt-v4 §9.5).
 /// Both denominators are positive whenever `cos²t > 0`, so `F` is never NaN.
-#[inline]
+#[inline(never)]
 pub fn interface(d: UnitVec3, n: UnitVec3, eta: f32) -> Interface {
     let cos_i = (-n.dot(d.get())).clamp(0.0, 1.0);
     let eta_cos_i = eta * cos_i;

@@ -176,6 +176,9 @@ impl<S: CausticStore> CausticStore for Timed<'_, S> {
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, m: &Classic) -> Rgb {
         self.time(|| self.inner.classic(x, n, to_eye, m))
     }
+    fn reaches(&self, x: Vec3) -> bool {
+        self.inner.reaches(x)
+    }
     fn irradiance_within(&self, x: Vec3, n: UnitVec3, f: &Footprint) -> Halves {
         self.time(|| self.inner.irradiance_within(x, n, f))
     }

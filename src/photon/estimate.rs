@@ -157,9 +157,12 @@ impl Region {
 
 /// A kd-tree photon map used as a caustic store, gathering up to `K` photons
 /// (the compiled capacity of the gather; `k ≤ K` photons are used), or every photon
-/// within a fixed radius.
+/// within a fixed radius. `N` bounds the photons the map holds (a device map's
+/// capacity, [`holding_at_most`](Self::holding_at_most); unbounded by default): with
+/// `N ≤` [`FOOTPRINT_VISITS`] one search always covers a footprint, so the cut into
+/// segments, the coarse levels and the scaling are not compiled.
 #[derive(Clone, Copy, Debug)]
-pub struct KdStore<'a, const K: usize> {
+pub struct KdStore<'a, const K: usize, const N: usize = { usize::MAX }> {
     tree: KdTree<'a>,
     /// Power of one unit of stored photon power, W.
     unit: f32,
@@ -194,7 +197,7 @@ pub const FOOTPRINT_VISITS: usize = 1024;
 /// focus seen through the tube.
 pub const SPARSE_FOOTPRINT: u32 = 16;
 
-impl<'a, const K: usize> KdStore<'a, K> {
+impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
     /// A store over a balanced tree whose photon powers are in units of `unit` W,
     /// gathering the `k` nearest photons (clamped to `1..=K`) within `max_radius`, or,
     /// with `k = None`, every photon within `max_radius` (the fixed-radius gather of
@@ -215,6 +218,20 @@ impl<'a, const K: usize> KdStore<'a, K> {
             bounds: bounds(tree.photons()),
             coarse: [None; 2],
         }
+    }
+
+    /// The same store, stating that its map holds at most `M` photons; `None` when it
+    /// holds more.
+    pub fn holding_at_most<const M: usize>(self) -> Option<KdStore<'a, K, M>> {
+        (self.tree.photons().len() <= M).then_some(KdStore {
+            tree: self.tree,
+            unit: self.unit,
+            k: self.k,
+            max_radius2: self.max_radius2,
+            cone: self.cone,
+            bounds: self.bounds,
+            coarse: self.coarse,
+        })
     }
 
     /// The same store with coarse levels for large footprints: `level1` holds every
@@ -333,6 +350,25 @@ impl<'a, const K: usize> KdStore<'a, K> {
         weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> Option<(Halves, f32)> {
         let region = Region::new(footprint, self.max_radius2)?;
+        if N <= FOOTPRINT_VISITS {
+            // No search can visit more photons than the map holds: the first always
+            // completes (the loop below would return the same sums). No reach test
+            // either: the renderer asks `reaches` first, and a search out of reach
+            // finds nothing, the same zero.
+            let (mut region, mut grown) = (region, false);
+            loop {
+                let (sum, _, found) = self.sum_in(Some(self.tree), x, n, &region, false, weight);
+                match self.grown(&region, found).filter(|_| !grown) {
+                    Some(larger) => (region, grown) = (larger, true),
+                    None => {
+                        return Some((
+                            Halves::from_parts(sum[0], sum[1]).scaled(self.unit),
+                            region.area,
+                        ))
+                    }
+                }
+            }
+        }
         if self.out_of_reach(x) {
             return Some((Halves::default(), region.area));
         }
@@ -347,14 +383,13 @@ impl<'a, const K: usize> KdStore<'a, K> {
         loop {
             let (sum, visits, found) = self.sum_in(levels[level], x, n, &region, cut, weight);
             if visits.is_some() {
-                let sparse = level == 0 && found < SPARSE_FOOTPRINT;
-                if sparse && !grown && region.reach2 * 4.0 <= self.max_radius2 {
-                    (region, grown, cut) = (region.scaled(4.0), true, false);
+                if let Some(larger) = self.grown(&region, found).filter(|_| level == 0 && !grown) {
+                    (region, grown, cut) = (larger, true, false);
                     continue;
                 }
                 let scale = [1, THINNING, THINNING * THINNING][level] as f32 * self.unit;
                 return Some((
-                    Halves::from_parts(sum[0] * scale, sum[1] * scale),
+                    Halves::from_parts(sum[0], sum[1]).scaled(scale),
                     region.area,
                 ));
             }
@@ -366,6 +401,15 @@ impl<'a, const K: usize> KdStore<'a, K> {
                 region = region.scaled(0.25);
             }
         }
+    }
+
+    /// The region twice the size of `region` about the same centre when `found`, the
+    /// photons it held, are fewer than [`SPARSE_FOOTPRINT`] and the larger one is
+    /// within the store's radius.
+    #[inline]
+    fn grown(&self, region: &Region, found: u32) -> Option<Region> {
+        (found < SPARSE_FOOTPRINT && region.reach2 * 4.0 <= self.max_radius2)
+            .then(|| region.scaled(4.0))
     }
 
     /// The level to try first: the finest whose photons in the region's reach are
@@ -389,7 +433,7 @@ impl<'a, const K: usize> KdStore<'a, K> {
     /// The weighted sums of the front-side photons of `tree` inside `region`, of the
     /// forward pass's half 0 and half 1, the photons visited (`None` when they would
     /// exceed [`FOOTPRINT_VISITS`]) and the photons summed.
-    #[inline(never)]
+    #[inline]
     fn sum_in(
         &self,
         tree: Option<KdTree<'_>>,
@@ -475,7 +519,7 @@ fn bounds(photons: &[Photon]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
-impl<const K: usize> CausticStore for KdStore<'_, K> {
+impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
     /// `E = Σ Φ_p / (π r²)` over the k nearest front-side photons, `r` the distance to
     /// the k-th (or the maximum radius when fewer are found): Jensen 2001, eq. 7.6,
     /// divided by the diffuse BRDF.
@@ -496,6 +540,12 @@ impl<const K: usize> CausticStore for KdStore<'_, K> {
         }
         let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
         sum * (1.0 / r2)
+    }
+
+    /// `false` beyond the maximum radius from the photons' bounding box.
+    #[inline]
+    fn reaches(&self, x: Vec3) -> bool {
+        !self.out_of_reach(x)
     }
 
     /// `E = Σ Φ_p / A` over the front-side photons inside the footprint of area `A`

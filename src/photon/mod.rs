@@ -50,6 +50,14 @@ pub trait CausticStore {
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
 
+    /// `false` only where every estimate at `x` is zero whatever the footprint (no
+    /// photon can lie within reach): the renderer then does not work out the footprint
+    /// of a diffuse point seen through glass. The default, `true`, is always sound.
+    fn reaches(&self, x: Vec3) -> bool {
+        let _ = x;
+        true
+    }
+
     /// As [`irradiance`](Self::irradiance), averaged over the patch one eye sample
     /// stands for (a diffuse point seen through glass or in a mirror): the box filter of
     /// a pixel, with the difference of its two halves' estimates. A store that cannot

@@ -2,7 +2,10 @@
 //! (Igehy 1999, "Tracing Ray Differentials"; pbrt-v4 §10.1), carried through every
 //! mirror reflection and refraction so that a diffuse point seen through glass knows
 //! the patch of surface its pixel covers there — magnified by a ball, stretched along
-//! one axis by a tube — and the caustic store averages over exactly that patch.
+//! one axis by a tube — and the caustic store averages over exactly that patch. They
+//! are not stored with each branch: the path's specular vertices are ([`Trail`]), and
+//! a gather replays the recurrences below through them, the same operations on the
+//! same values as carrying them along.
 //!
 //! With `D` the unit direction, `N` the normal facing the ray (`D·N < 0`) and `∂` a
 //! derivative along the image's x or y:
@@ -15,120 +18,230 @@
 //! with `∂(D·N) = ∂D·N + D·∂N` and `∂N` from the shape
 //! ([`Shape::normal_derivative`](crate::geometry::Shape::normal_derivative)).
 
+use heapless::Vec as FixedVec;
+
+use crate::camera::Camera;
 use crate::geometry::{Hit, Shape};
 use crate::math::{UnitVec3, Vec3};
+use crate::scene::Object;
 
-/// The derivatives of a ray's origin and direction along the image's x and y, per step
-/// of the sample's extent on the image (a pixel, or a sub-pixel of a grid).
+/// The derivatives of a ray's origin and direction along one of the image's axes (x
+/// or y), per step of the sample's extent on the image (a pixel, or a sub-pixel of a
+/// grid). The two axes never mix, so each is carried on its own: one copy of the code.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Differential {
-    /// `∂P/∂x`, `∂P/∂y`.
-    pub dp: [Vec3; 2],
-    /// `∂D/∂x`, `∂D/∂y`.
-    pub dd: [Vec3; 2],
+    /// `∂P`.
+    pub dp: Vec3,
+    /// `∂D`.
+    pub dd: Vec3,
 }
 
 impl Differential {
     /// A pinhole camera ray: the origin is fixed, the direction turns by `dd`.
     #[inline]
-    pub fn camera(dd: [Vec3; 2]) -> Self {
-        Self {
-            dp: [Vec3::ZERO; 2],
-            dd,
-        }
+    pub fn camera(dd: Vec3) -> Self {
+        Self { dp: Vec3::ZERO, dd }
     }
 
-    /// The differentials at a hit `t` along direction `d`, on a surface of normal `n`
-    /// (either orientation): the direction's are unchanged.
+    /// The differential at a hit `t` along direction `d`, on a surface of normal `n`
+    /// (either orientation): the direction's is unchanged.
     #[inline]
     pub fn transfer(&self, d: Vec3, t: f32, n: Vec3) -> Self {
         let dn = d.dot(n);
-        let dp = |i: usize| {
-            let moved = self.dp[i] + self.dd[i] * t;
-            moved - d * (moved.dot(n) / dn)
-        };
+        let moved = self.dp + self.dd * t;
         Self {
-            dp: [dp(0), dp(1)],
+            dp: moved - d * (moved.dot(n) / dn),
             dd: self.dd,
         }
     }
 
     /// The reflected ray's, about the normal `n` facing `d` that turns by `dn`.
     #[inline]
-    pub fn reflect(&self, d: Vec3, n: Vec3, dn: [Vec3; 2]) -> Self {
+    pub fn reflect(&self, d: Vec3, n: Vec3, dn: Vec3) -> Self {
         let d_n = d.dot(n);
-        let dd = |i: usize| {
-            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
-            self.dd[i] - (dn[i] * d_n + n * dd_n) * 2.0
-        };
+        let dd_n = self.dd.dot(n) + d.dot(dn);
         Self {
             dp: self.dp,
-            dd: [dd(0), dd(1)],
+            dd: self.dd - (dn * d_n + n * dd_n) * 2.0,
         }
     }
 
     /// The refracted ray's (direction `t_dir`), about the normal `n` facing `d` that
     /// turns by `dn`, with `eta = η_i/η_t`.
     #[inline]
-    pub fn refract(&self, d: Vec3, t_dir: Vec3, n: Vec3, dn: [Vec3; 2], eta: f32) -> Self {
+    pub fn refract(&self, d: Vec3, t_dir: Vec3, n: Vec3, dn: Vec3, eta: f32) -> Self {
         let (d_n, t_n) = (d.dot(n), t_dir.dot(n));
         let mu = eta * d_n - t_n;
         let dmu_per = eta - eta * eta * d_n / t_n;
-        let dd = |i: usize| {
-            let dd_n = self.dd[i].dot(n) + d.dot(dn[i]);
-            self.dd[i] * eta - (dn[i] * mu + n * (dmu_per * dd_n))
-        };
+        let dd_n = self.dd.dot(n) + d.dot(dn);
         Self {
             dp: self.dp,
-            dd: [dd(0), dd(1)],
+            dd: self.dd * eta - (dn * mu + n * (dmu_per * dd_n)),
         }
     }
 }
 
-/// A branch's differentials transferred to a specular hit, with the normal facing the
-/// ray and that normal's turn across the sample: what the reflected and refracted
-/// branches' differentials are made from.
+/// A branch's differential transferred to a specular hit, with the normal facing the
+/// ray and that normal's turn along the same image axis: what the reflected and
+/// refracted branches' differentials are made from.
 pub(crate) struct Turn {
     at: Differential,
     d: Vec3,
     n: Vec3,
-    dn: [Vec3; 2],
+    dn: Vec3,
 }
 
 impl Turn {
-    /// Transfers `diff`, of a ray along `d`, to `hit` on `shape`, whose normal facing
-    /// the ray is `facing`.
-    #[inline(never)]
+    /// Transfers `diff`, of a ray along `d`, to its hit `t` along it on `shape`, of
+    /// outward normal `normal` there; `front`: the ray arrived on the side `normal`
+    /// points to.
+    #[inline]
     pub fn at(
         diff: &Differential,
         d: UnitVec3,
-        hit: &Hit,
+        (t, normal): (f32, UnitVec3),
         shape: &Shape,
-        facing: UnitVec3,
+        front: bool,
     ) -> Self {
         let d = d.get();
-        let at = diff.transfer(d, hit.t, hit.normal.get());
-        // The outward normal's turn, flipped with the normal when the ray is inside.
-        let sign = if facing == hit.normal { 1.0 } else { -1.0 };
-        let turn = |i: usize| shape.normal_derivative(hit.normal, at.dp[i]) * sign;
+        let at = diff.transfer(d, t, normal.get());
+        // The normal facing the ray, and its turn: the outward normal's, flipped with it
+        // when the ray is inside.
+        let (facing, sign) = if front {
+            (normal, 1.0)
+        } else {
+            (-normal, -1.0)
+        };
         Self {
             at,
             d,
             n: facing.get(),
-            dn: [turn(0), turn(1)],
+            dn: shape.normal_derivative(normal, at.dp) * sign,
         }
     }
 
     /// The mirror-reflected branch's differentials.
-    #[inline(never)]
+    #[inline]
     pub fn reflect(&self) -> Differential {
         self.at.reflect(self.d, self.n, self.dn)
     }
 
     /// The refracted branch's differentials, along `t`, with `eta = η_i/η_t`.
-    #[inline(never)]
+    #[inline]
     pub fn refract(&self, t: UnitVec3, eta: f32) -> Differential {
         self.at.refract(self.d, t.get(), self.n, self.dn, eta)
+    }
+}
+
+/// How a branch leaves the specular vertex it starts at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Bend {
+    /// Mirror reflection (also a classic surface's transmitted part under total
+    /// internal reflection, which follows the reflected ray).
+    Reflect,
+    /// Refraction, with `η = η_i/η_t` of the vertex.
+    Refract,
+}
+
+/// One specular interaction of the path being traced: what [`Turn::at`] and the bend
+/// of the branch leaving it need, recorded instead of the differentials themselves.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    /// The arriving ray's direction, and how it left the vertex before (the arriving
+    /// branch's bend; unused at the first vertex, which the camera ray reaches).
+    d: UnitVec3,
+    bend: Bend,
+    /// The hit: ray parameter, outward normal, object, side.
+    t: f32,
+    normal: UnitVec3,
+    object: usize,
+    front: bool,
+    /// `η_i/η_t` for a refracted branch.
+    eta: f32,
+}
+
+/// The specular vertices of the eye path being traced, from the camera, replayed into
+/// a branch's differentials only where a gather needs them (Igehy's recurrences in the
+/// same order on the same values: the same bits as carrying them along every branch).
+/// Most branches never reach a diffuse point near a photon (Fig. 6 on the device:
+/// 80 footprint gathers against 12 300 reflected and refracted branches), so carrying
+/// 48 bytes of differentials through every fork costs far more than replaying a few.
+///
+/// The walk is depth-first and each pending branch waits at a depth of its own, so
+/// when a branch at depth `k` is traced the first `k` vertices are its own ancestors:
+/// a vertex recorded at depth `k` replaces everything from `k` on.
+#[derive(Debug)]
+pub(crate) struct Trail<const DEPTH: usize> {
+    vertices: FixedVec<Vertex, DEPTH>,
+    /// The sample's extent on the image, pixels (`1/m` for an `m × m` grid).
+    step: f32,
+}
+
+impl<const DEPTH: usize> Trail<DEPTH> {
+    /// No vertex yet, for a sample `step` pixels wide.
+    #[inline]
+    pub fn new(step: f32) -> Self {
+        Self {
+            vertices: FixedVec::new(),
+            step,
+        }
+    }
+
+    /// Records the specular hit of a branch at `depth` that arrived along `d` by `bend`,
+    /// on `object` (the scene's index); `eta` for its refracted branch.
+    #[inline(never)]
+    pub fn record(
+        &mut self,
+        depth: u32,
+        (d, bend): (UnitVec3, Bend),
+        hit: &Hit,
+        object: usize,
+        eta: f32,
+    ) {
+        self.vertices.truncate(depth as usize);
+        let vertex = Vertex {
+            d,
+            bend,
+            t: hit.t,
+            normal: hit.normal,
+            object,
+            front: hit.front_face(d),
+            eta,
+        };
+        if self.vertices.push(vertex).is_err() {
+            debug_assert!(false, "trail overflow: DEPTH < max_depth");
+        }
+    }
+
+    /// The differentials along the image's x and y of the branch at `depth` that left
+    /// its last vertex along `dir` by `bend`: the camera's, carried through the first
+    /// `depth` vertices (the two axes side by side, one copy of the code for both).
+    #[inline(never)]
+    pub fn differentials(
+        &self,
+        camera: &Camera,
+        objects: &[Object],
+        depth: u32,
+        (dir, bend): (UnitVec3, Bend),
+    ) -> [Differential; 2] {
+        let path = &self.vertices[..(depth as usize).min(self.vertices.len())];
+        let root = path.first().map_or(dir, |v| v.d);
+        let dd = camera.direction_derivatives(root);
+        let mut diffs = dd.map(|dd| Differential::camera(dd * self.step));
+        for (k, v) in path.iter().enumerate() {
+            let (out, bend) = path
+                .get(k + 1)
+                .map_or((dir, bend), |next| (next.d, next.bend));
+            let shape = &objects[v.object].shape;
+            for diff in &mut diffs {
+                let turn = Turn::at(diff, v.d, (v.t, v.normal), shape, v.front);
+                *diff = match bend {
+                    Bend::Reflect => turn.reflect(),
+                    Bend::Refract => turn.refract(out, v.eta),
+                };
+            }
+        }
+        diffs
     }
 }
 
@@ -145,32 +258,30 @@ mod tests {
     /// or totally reflects.
     fn follow(
         ray: Ray,
-        diff: Differential,
+        diff: [Differential; 2],
         specular: &[(Shape, bool)],
         floor: &Shape,
-    ) -> Option<(Vec3, Differential)> {
+    ) -> Option<(Vec3, [Differential; 2])> {
         let (mut ray, mut diff) = (ray, diff);
         for (shape, mirror) in specular {
             let hit = shape.intersect(&ray, f32::INFINITY)?;
             let d = ray.dir;
             let front = hit.front_face(d);
             let facing = if front { hit.normal } else { -hit.normal };
-            let turn = Turn::at(&diff, d, &hit, shape, facing);
+            let turn = |diff: &Differential| Turn::at(diff, d, (hit.t, hit.normal), shape, front);
             let (dir, next) = if *mirror {
-                (reflect(d, facing), turn.reflect())
+                (reflect(d, facing), diff.map(|a| turn(&a).reflect()))
             } else {
                 let eta = if front { 1.0 / 1.5 } else { 1.5 };
                 let t = interface(d, facing, eta).refracted?;
-                (t, turn.refract(t, eta))
+                (t, diff.map(|a| turn(&a).refract(t, eta)))
             };
             ray = Ray::spawn(&hit, dir);
             diff = next;
         }
         let hit = floor.intersect(&ray, f32::INFINITY)?;
-        Some((
-            hit.point,
-            diff.transfer(ray.dir.get(), hit.t, hit.normal.get()),
-        ))
+        let at = |a: Differential| a.transfer(ray.dir.get(), hit.t, hit.normal.get());
+        Some((hit.point, diff.map(at)))
     }
 
     /// The differentials carried through curved glass (into and out of a sphere, of a
@@ -199,7 +310,9 @@ mod tests {
                 for px in (4..320).step_by(8) {
                     let at = |x: f32, y: f32| camera.ray_at(px, py, x, y);
                     let ray = at(0.5, 0.5);
-                    let diff = Differential::camera(camera.direction_derivatives(ray.dir));
+                    let diff = camera
+                        .direction_derivatives(ray.dir)
+                        .map(Differential::camera);
                     let Some((_, d)) = follow(ray, diff, specular, target) else {
                         continue;
                     };
@@ -211,7 +324,7 @@ mod tests {
                             continue;
                         };
                         let fd = (plus - minus) / (2.0 * h);
-                        errors.push((fd - d.dp[i]).length() / fd.length());
+                        errors.push((fd - d[i].dp).length() / fd.length());
                     }
                 }
             }
@@ -230,5 +343,71 @@ mod tests {
                 errors.len()
             );
         }
+    }
+
+    /// A branch of an eye path: its ray, depth, how it left its vertex, and the
+    /// differentials carried to it.
+    type Pending = (Ray, u32, Bend, [Differential; 2]);
+
+    /// Replaying the trail gives, bit for bit, the differentials carried through every
+    /// vertex, at every hit of every branch of a path tree walked depth first as the
+    /// renderer walks it (a branch waits on a stack while its sibling records deeper
+    /// vertices, then records its own over them): through the glass sphere and off the
+    /// mirror of the device's glass scene, both image axes, a 2×2 grid's sub-pixel.
+    #[test]
+    fn the_trail_replays_the_carried_differentials_bit_for_bit() {
+        use crate::material::Material;
+        let scene = crate::demo::glass::<4, 1>(320, 240).unwrap();
+        let (camera, objects) = (scene.camera(), scene.objects());
+        let step = 0.5;
+        let (mut checked, mut overwritten) = (0, 0);
+        for py in (2..240).step_by(5) {
+            for px in (2..320).step_by(5) {
+                let ray = camera.ray_at(px, py, 0.25, 0.75);
+                let dd = camera.direction_derivatives(ray.dir);
+                let carried = dd.map(|d| Differential::camera(d * step));
+                let mut trail = Trail::<4>::new(step);
+                let mut stack: std::vec::Vec<Pending> = std::vec![(ray, 0, Bend::Reflect, carried)];
+                while let Some((ray, depth, bend, carried)) = stack.pop() {
+                    let Some((hit, index)) = scene.intersect(&ray, f32::INFINITY) else {
+                        continue;
+                    };
+                    let d = ray.dir;
+                    if depth > 0 {
+                        let replayed = trail.differentials(camera, objects, depth, (d, bend));
+                        assert_eq!(replayed, carried, "depth {depth}");
+                        checked += 1;
+                    }
+                    let front = hit.front_face(d);
+                    let facing = if front { hit.normal } else { -hit.normal };
+                    let eta = match objects[index].material {
+                        Material::Dielectric(g) if front => 1.0 / g.ior,
+                        Material::Dielectric(g) => g.ior,
+                        Material::Mirror(_) => 1.0,
+                        _ => continue,
+                    };
+                    if depth == 3 {
+                        continue;
+                    }
+                    overwritten += usize::from(trail.vertices.len() > depth as usize);
+                    trail.record(depth, (d, bend), &hit, index, eta);
+                    let shape = &objects[index].shape;
+                    let turn = |a: &Differential| Turn::at(a, d, (hit.t, hit.normal), shape, front);
+                    let reflected = carried.map(|a| turn(&a).reflect());
+                    let r = Ray::spawn(&hit, reflect(d, facing));
+                    stack.push((r, depth + 1, Bend::Reflect, reflected));
+                    if let Material::Dielectric(_) = objects[index].material {
+                        if let Some(t) = interface(d, facing, eta).refracted {
+                            let bent = carried.map(|a| turn(&a).refract(t, eta));
+                            stack.push((Ray::spawn(&hit, t), depth + 1, Bend::Refract, bent));
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            checked >= 1000 && overwritten >= 10,
+            "{checked}, {overwritten}"
+        );
     }
 }

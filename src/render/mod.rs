@@ -20,8 +20,11 @@
 //! surface the sample stands for: the parallelogram its ray differentials span there
 //! (Igehy 1999, carried through every reflection and refraction: magnified by a ball,
 //! stretched by a tube), bounded by the store's own radius — the pixel's box filter
-//! under the differentials' linearisation ([`Footprint`]). Without splats the store
-//! gathers at every diffuse hit, as in the paper.
+//! under the differentials' linearisation ([`Footprint`]). The path records its
+//! specular vertices and the differentials are worked out from them only at such a
+//! gather, and only where a photon may lie within reach ([`CausticStore::reaches`]):
+//! most branches never need them. Without splats the store gathers at every diffuse
+//! hit, as in the paper.
 //!
 //! A pixel's value is the average radiance over its area (box filter). The default
 //! [`Sampling::Adaptive`] traces the pixel's four corners (Whitted 1980's adaptive
@@ -65,8 +68,8 @@ use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
 use crate::photon::{CausticStore, Footprint, Halves, Splat};
-use crate::scene::{Object, Scene};
-use differential::{Differential, Turn};
+use crate::scene::Scene;
+use differential::{Bend, Trail};
 
 mod differential;
 mod estimate;
@@ -136,6 +139,8 @@ impl core::ops::AddAssign for RayCount {
 enum Gather {
     /// The forward pass's splats hold it already (seen directly): no gather.
     Splatted,
+    /// No photon can lie within the store's reach: the footprint's estimate is zero.
+    Dark,
     /// The store's own gather, as its settings say (the paper's way, without splats).
     Store,
     /// The photons within the patch the sample stands for, from its ray differentials
@@ -149,9 +154,30 @@ struct Branch {
     ray: Ray,
     weight: Rgb,
     depth: u32,
-    /// How the ray moves across the sample's extent on the image (its pixel, or its
-    /// sub-pixel in a grid).
-    diff: Differential,
+    /// How it left the specular vertex it starts at (the camera's ray: `Reflect`,
+    /// unused): with the [`Trail`] of vertices, what its ray differentials are made from.
+    bend: Bend,
+}
+
+/// A branch a specular hit spawns, before it is placed: its direction, weight and bend.
+#[derive(Clone, Copy, Debug)]
+struct Child {
+    dir: UnitVec3,
+    weight: Rgb,
+    bend: Bend,
+}
+
+impl Child {
+    /// The branch, from `hit`, at `depth`.
+    #[inline]
+    fn branch(self, hit: &Hit, depth: u32) -> Branch {
+        Branch {
+            ray: Ray::spawn(hit, self.dir),
+            weight: self.weight,
+            depth,
+            bend: self.bend,
+        }
+    }
 }
 
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
@@ -307,98 +333,125 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> Sample {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
-        let [dx, dy] = self.scene.camera().direction_derivatives(ray.dir);
-        let step = 1.0 / m.max(1) as f32;
-        let mut next = Some(Branch {
+        let mut trail = Trail::new(1.0 / m.max(1) as f32);
+        let mut b = Branch {
             ray,
             weight: Rgb::ONE,
             depth: 0,
-            diff: Differential::camera([dx * step, dy * step]),
-        });
+            bend: Bend::Reflect,
+        };
         let limit = count.eye + count.shadow + self.ray_budget as u64;
-        while let Some(b) = next.take().or_else(|| stack.pop()) {
+        loop {
             if count.eye + count.shadow + self.rays_per_hit as u64 > limit {
                 break; // the budget is spent: drop this and every pending branch
             }
             count.eye += 1;
-            let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) else {
+            if let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) {
+                out.mix(index as u32 | b.depth << 16);
+                let (local, [first, second]) =
+                    self.scatter(&b, &hit, index, &mut trail, count, &mut out);
+                out.radiance += local;
+                // Continue with the heavier branch, keep the other for later (a
+                // different depth from every branch already waiting, so the stack never
+                // overflows). Each is made where it goes, not moved there.
+                let sum =
+                    |c: &Option<Child>| c.map_or(0.0, |c| c.weight.r + c.weight.g + c.weight.b);
+                let (heavier, lighter) = if sum(&second) > sum(&first) {
+                    (second, first)
+                } else {
+                    (first, second)
+                };
+                let depth = b.depth + 1;
+                if let Some(c) = lighter {
+                    if stack.push(c.branch(&hit, depth)).is_err() {
+                        debug_assert!(false, "path stack overflow: DEPTH < max_depth");
+                    }
+                }
+                if let Some(c) = heavier {
+                    b = c.branch(&hit, depth);
+                    continue;
+                }
+            } else {
                 out.mix(u32::MAX);
                 out.radiance += b.weight * self.scene.background();
-                continue;
-            };
-            out.mix(index as u32 | b.depth << 16);
-            let object = &self.scene.objects()[index];
-            let (local, first, second) = self.scatter(&b, &hit, object, count, &mut out);
-            out.radiance += local;
-            // Continue with the heavier branch, keep the other for later (a different
-            // depth from every branch already waiting, so the stack never overflows).
-            let sum = |b: &Option<Branch>| b.map_or(0.0, |b| b.weight.r + b.weight.g + b.weight.b);
-            let (heavier, lighter) = if sum(&second) > sum(&first) {
-                (second, first)
-            } else {
-                (first, second)
-            };
-            if let Some(s) = lighter {
-                if stack.push(s).is_err() {
-                    debug_assert!(false, "path stack overflow: DEPTH < max_depth");
-                }
             }
-            next = heavier;
+            match stack.pop() {
+                Some(pending) => b = pending,
+                None => break,
+            }
         }
         out
     }
 
     /// How the caustic store gathers at the diffuse point `hit` reached by branch `b`:
     /// behind glass or a mirror, over the parallelogram spanned by the half-steps of
-    /// the branch's differentials there.
-    #[inline]
-    fn gather(&self, b: &Branch, hit: &Hit) -> Gather {
+    /// the branch's differentials there (replayed from the `trail`, and only where a
+    /// photon may lie within reach).
+    #[inline(always)]
+    fn gather(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
         match self.splats {
             None => Gather::Store,
             Some(_) if b.depth == 0 => Gather::Splatted,
-            Some(_) => {
-                let at = b.diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get());
-                Gather::Footprint(Footprint {
-                    a: at.dp[0] * 0.5,
-                    b: at.dp[1] * 0.5,
-                })
-            }
+            Some(_) => self.behind(b, hit, trail),
         }
     }
 
-    /// Light leaving `hit` towards the eye directly, and up to two specular branches;
+    /// The gather at `hit` seen through glass or in a mirror along `b`: over the
+    /// half-steps of its differentials there, where a photon may lie within reach.
+    #[inline(never)]
+    fn behind(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
+        if !self.store.reaches(hit.point) {
+            return Gather::Dark;
+        }
+        let (camera, objects) = (self.scene.camera(), self.scene.objects());
+        let diffs = trail.differentials(camera, objects, b.depth, (b.ray.dir, b.bend));
+        let [a, b] =
+            diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
+        Gather::Footprint(Footprint { a, b })
+    }
+
+    /// Light leaving `hit` towards the eye directly, and up to two specular branches
+    /// (reflected, refracted);
     /// the caustic part and the path's events go to `log`.
     #[inline]
     fn scatter(
         &self,
         b: &Branch,
         hit: &Hit,
-        object: &Object,
+        index: usize,
+        trail: &mut Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
-    ) -> (Rgb, Option<Branch>, Option<Branch>) {
+    ) -> (Rgb, [Option<Child>; 2]) {
+        let object = &self.scene.objects()[index];
         let d = b.ray.dir;
         let front = hit.front_face(d);
         let facing = if front { hit.normal } else { -hit.normal };
         let can_bounce = b.depth < self.max_depth;
-        // Negligible throughput: not traced (see the module documentation).
-        let traced = |w: Rgb| !w.is_black() && w.max_channel() >= self.cutoff;
-        let branch = |dir: UnitVec3, weight: Rgb, diff: Differential| Branch {
-            ray: Ray::spawn(hit, dir),
-            weight,
-            depth: b.depth + 1,
-            diff,
+        // Negligible throughput: not traced (see the module documentation). The
+        // largest channel (NaN only when all are) is positive exactly when the weight
+        // is not black.
+        let traced = |w: Rgb| {
+            let m = w.max_channel();
+            m > 0.0 && m >= self.cutoff
+        };
+        let branch = |dir: UnitVec3, weight: Rgb, bend: Bend| Child { dir, weight, bend };
+        // The vertex the branches leave from, for their differentials.
+        let record = |trail: &mut Trail<DEPTH>, eta: f32| {
+            trail.record(b.depth, (d, b.bend), hit, index, eta);
         };
         match &object.material {
-            Material::Diffuse(m) if front => (self.diffuse(b, hit, m, count, log), None, None),
-            Material::Diffuse(_) => (Rgb::ZERO, None, None),
+            Material::Diffuse(m) if front => {
+                (self.diffuse(b, hit, m, trail, count, log), [None, None])
+            }
+            Material::Diffuse(_) => (Rgb::ZERO, [None, None]),
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
                 let reflected = traced(w).then(|| {
-                    let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
-                    branch(reflect(d, facing), w, turn.reflect())
+                    record(trail, 1.0);
+                    branch(reflect(d, facing), w, Bend::Reflect)
                 });
-                (Rgb::ZERO, reflected, None)
+                (Rgb::ZERO, [reflected, None])
             }
             Material::Dielectric(g) if can_bounce => {
                 let weight = if front {
@@ -408,48 +461,48 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 };
                 let eta = if front { 1.0 / g.ior } else { g.ior };
                 let i = interface(d, facing, eta);
-                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
+                record(trail, eta);
                 let w = weight * i.reflectance;
-                let reflected = traced(w).then(|| branch(reflect(d, facing), w, turn.reflect()));
+                let reflected = traced(w).then(|| branch(reflect(d, facing), w, Bend::Reflect));
                 let w = weight * ((1.0 - i.reflectance) * eta * eta);
                 let refracted = i
                     .refracted
                     .filter(|_| traced(w))
-                    .map(|t| branch(t, w, turn.refract(t, eta)));
-                (Rgb::ZERO, reflected, refracted)
+                    .map(|t| branch(t, w, Bend::Refract));
+                (Rgb::ZERO, [reflected, refracted])
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(b, hit, c, -d, count, log)
+                    self.classic_local(b, hit, c, trail, count, log)
                 } else {
                     Rgb::ZERO
                 };
                 if !can_bounce {
-                    return (b.weight * local, None, None);
+                    return (b.weight * local, [None, None]);
                 }
                 let eta = if front { 1.0 / c.ior } else { c.ior };
                 let r = reflect(d, facing);
                 let (wr, wt) = (b.weight * c.reflectivity, b.weight * c.transparency);
                 if !traced(wr + wt) {
-                    return (b.weight * local, None, None);
+                    return (b.weight * local, [None, None]);
                 }
-                let turn = Turn::at(&b.diff, b.ray.dir, hit, &object.shape, facing);
+                record(trail, eta);
                 // Under total internal reflection the transmitted part follows the
                 // reflected ray: one ray carries both.
                 let (reflected, refracted) = match interface(d, facing, eta).refracted {
                     Some(t) => (
-                        traced(wr).then(|| branch(r, wr, turn.reflect())),
-                        traced(wt).then(|| branch(t, wt, turn.refract(t, eta))),
+                        traced(wr).then(|| branch(r, wr, Bend::Reflect)),
+                        traced(wt).then(|| branch(t, wt, Bend::Refract)),
                     ),
                     None => {
                         let w = wr + wt;
-                        (traced(w).then(|| branch(r, w, turn.reflect())), None)
+                        (traced(w).then(|| branch(r, w, Bend::Reflect)), None)
                     }
                 };
-                (b.weight * local, reflected, refracted)
+                (b.weight * local, [reflected, refracted])
             }
             // A specular surface after max_depth interactions contributes nothing.
-            Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, None, None),
+            Material::Mirror(_) | Material::Dielectric(_) => (Rgb::ZERO, [None, None]),
         }
     }
 
@@ -461,13 +514,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         b: &Branch,
         hit: &Hit,
         m: &crate::material::Diffuse,
+        trail: &Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> Rgb {
-        let caustic = match self.gather(b, hit) {
+        let caustic = match self.gather(b, hit, trail) {
             Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
             Gather::Store => Halves::whole(self.store.irradiance(hit.point, hit.normal)),
-            Gather::Splatted => Halves::default(),
+            Gather::Splatted | Gather::Dark => Halves::default(),
         };
         let mut e = caustic.total;
         for light in self.scene.lights() {
@@ -483,17 +537,17 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         f * e * core::f32::consts::FRAC_1_PI
     }
 
-    /// The classic model's local part at a front-side hit seen from `to_eye`.
+    /// The classic model's local part at a front-side hit, seen along `b`.
     fn classic_local(
         &self,
         b: &Branch,
         hit: &Hit,
         c: &Classic,
-        to_eye: UnitVec3,
+        trail: &Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> Rgb {
-        let n = hit.normal;
+        let (n, to_eye) = (hit.normal, -b.ray.dir);
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
@@ -503,10 +557,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        let caustic = match self.gather(b, hit) {
+        let caustic = match self.gather(b, hit, trail) {
             Gather::Footprint(f) => self.store.classic_within(hit.point, n, to_eye, c, &f),
             Gather::Store => Halves::whole(self.store.classic(hit.point, n, to_eye, c)),
-            Gather::Splatted => Halves::default(),
+            Gather::Splatted | Gather::Dark => Halves::default(),
         };
         log.caustic += b.weight * caustic.total;
         log.split += b.weight * caustic.split;
