@@ -20,20 +20,32 @@
 //! [`balance`] reorders the caller's slice in place: `select_nth_unstable` around each
 //! range's middle, with an explicit stack of ranges; cost `O(N log N)`. A range of
 //! length `n` has children of lengths `⌊n/2⌋` and `⌊(n − 1)/2⌋`, so a split range at
-//! depth `d` holds at least 2 and at most `N/2^d` photons: at most 32 levels of
-//! splits for up to `2^32` photons. Queries walk the tree with a stack of the far
-//! sides still to search (one per level at most): nearer child first, the far child
-//! only while its splitting plane is within the search radius.
+//! depth `d` holds more than [`BUCKET`] and at most `N/2^d` photons: at most 29 levels
+//! of splits for up to `2^32` photons. Queries walk the tree depth first with a stack of
+//! the far sides still to search (one per split level at most): nearer child first,
+//! the far child only while its splitting plane is within the search radius.
 
 use super::packed::Photon;
 use crate::math::Vec3;
 
-/// Most photons in a leaf; a longer range is split. Measured on the renders of issue
-/// 12 (1.6M photons a light): 8 gathers fastest; 4 and 16 are a few percent slower.
+/// Most photons in a leaf; a longer range is split. Measured on issue 12's renders
+/// (callgrind, 200k photons a light): buckets of 4 and 16 execute 1–4 % more
+/// instructions on the scene of two balls, a mirror and a tube than 8 (4 is 0.6 %
+/// fewer on the tube scene).
 pub const BUCKET: usize = 8;
 
-/// Most levels of splits of an array of up to `2^32` photons (see the module docs).
-const MAX_DEPTH: usize = 32;
+/// Most levels of splits of an array of up to `2^32` photons: a split range at depth
+/// `d` holds more than [`BUCKET`] and at most `2^32/2^d` photons (29 for buckets of 8).
+const MAX_DEPTH: usize = {
+    let mut d = 0;
+    while (u32::MAX >> d) as usize > BUCKET {
+        d += 1;
+    }
+    d
+};
+
+// A split range is longer than BUCKET, so both its children are non-empty.
+const _: () = assert!(BUCKET >= 2);
 
 /// Balances `photons` in place into the kd-tree [`KdTree::from_balanced`] reads.
 pub fn balance(photons: &mut [Photon]) {
@@ -196,16 +208,22 @@ impl<'a> KdTree<'a> {
     /// from `x`; `visit` returns the (possibly smaller) radius² to search on with, and
     /// a radius² of 0 (or NaN) ends the search.
     ///
-    /// Depth first from the root: each splitting photon on the way is visited, the
-    /// walk goes on into the child on `x`'s side of its plane and keeps the other
-    /// child, with its plane's squared distance, on a stack (at most one per level, so
-    /// a fixed 32 entries that are never zeroed). A leaf is scanned in order; then the
-    /// most recent far side still within the current radius is searched.
+    /// Depth first from the root: each splitting photon on the way is visited, and the
+    /// walk goes on into the child on `x`'s side of its plane, keeping the other child
+    /// on a stack when the plane is within reach (at most one per split level: a fixed
+    /// 29 entries of 8 bytes, never zeroed). A leaf is scanned in order; then
+    /// the deepest kept far side whose plane is still within the current radius —
+    /// recomputed, as a k-nearest search shrinks it — is searched.
     #[inline]
     pub fn search(&self, x: Vec3, mut radius2: f32, mut visit: impl FnMut(usize, f32) -> f32) {
         let photons = self.photons;
         // An array, not `Vec3`: glam indexes a `Vec3` by a `match`, an array by address.
         let xa = x.to_array();
+        let plane = |m: usize| {
+            let p = &photons[m];
+            let axis = p.axis();
+            xa[axis] - p.coord(axis)
+        };
         let mut far: heapless::Vec<Far, MAX_DEPTH> = heapless::Vec::new();
         let (mut lo, mut hi) = (0usize, photons.len());
         loop {
@@ -222,19 +240,13 @@ impl<'a> KdTree<'a> {
                 }
                 let axis = p.axis();
                 let delta = xa[axis] - p.coord(axis);
-                let (near, other) = if delta < 0.0 {
-                    ((lo, m), (m + 1, hi))
-                } else {
-                    ((m + 1, hi), (lo, m))
-                };
-                let plane2 = delta * delta;
+                let near = if delta < 0.0 { (lo, m) } else { (m + 1, hi) };
                 // The far side can hold photons within reach only if its plane is.
-                if plane2 < radius2 && other.0 < other.1 {
-                    // Cannot fail: one entry per level of the path, ≤ MAX_DEPTH levels.
+                if delta * delta < radius2 {
+                    // Cannot fail: one entry per split level above, ≤ MAX_DEPTH of them.
                     let _ = far.push(Far {
-                        lo: other.0 as u32,
-                        hi: other.1 as u32,
-                        plane2,
+                        split: m as u32,
+                        end: if delta < 0.0 { hi } else { lo } as u32,
                     });
                 }
                 (lo, hi) = near;
@@ -248,11 +260,19 @@ impl<'a> KdTree<'a> {
                     }
                 }
             }
-            // The nearest pending far side still within the (possibly shrunk) radius.
+            // The deepest pending far side whose plane is still within the (possibly
+            // shrunk) radius.
             loop {
                 let Some(next) = far.pop() else { return };
-                if next.plane2 < radius2 {
-                    (lo, hi) = (next.lo as usize, next.hi as usize);
+                let split = next.split as usize;
+                let delta = plane(split);
+                if delta * delta < radius2 {
+                    let end = next.end as usize;
+                    (lo, hi) = if end > split {
+                        (split + 1, end)
+                    } else {
+                        (end, split)
+                    };
                     break;
                 }
             }
@@ -309,13 +329,13 @@ impl<'a> KdTree<'a> {
     }
 }
 
-/// A far side a search has still to visit: the range `lo..hi` beyond a splitting plane
-/// at squared distance `plane2` from the query point.
+/// A far side a search has still to visit: the child of the range split at `split`
+/// that ends at `end`, i.e. `split + 1..end` when `end > split`, else `end..split`.
+/// Eight bytes, so that the stack costs a device 8·[`MAX_DEPTH`] bytes of RAM.
 #[derive(Clone, Copy, Debug)]
 struct Far {
-    lo: u32,
-    hi: u32,
-    plane2: f32,
+    split: u32,
+    end: u32,
 }
 
 fn sift_up(heap: &mut [Neighbor], mut i: usize) {
