@@ -41,8 +41,8 @@ pub(super) fn desktop_budget<const O: usize, const L: usize>(
 }
 
 /// Balances the kd-tree on `threads` threads: the top levels on this one, then the
-/// subtrees below them — disjoint ranges of the array — on all, then the permutation
-/// into heap order. The same array as [`balance`], bit for bit.
+/// subtrees below them — disjoint ranges of the array — on all. The same array as
+/// [`balance`], bit for bit.
 fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress: &Progress) {
     // Below this a thread costs more than it saves.
     const SERIAL: usize = 1 << 15;
@@ -52,7 +52,6 @@ fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress:
         progress.tick();
         return;
     }
-    let n = photons.len();
     let mut subtrees = vec::Vec::new();
     // Four subtrees per thread, rounded up to a level: balances the load.
     let levels = usize::BITS - (4 * threads - 1).leading_zeros();
@@ -77,14 +76,11 @@ fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress:
             scope.spawn(|| loop {
                 let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
                 let Some((slice, t)) = next else { break };
-                photon::balance_subtree(slice, n, t);
+                photon::balance_subtree(slice, t);
                 progress.tick();
             });
         }
     });
-    // Every subtree is partitioned, and the slices' borrow of `photons` is over.
-    drop(work);
-    photon::balance_finish(photons);
 }
 
 /// Photons traced per work item of the parallel forward pass. Fixed, so that the order

@@ -3,7 +3,7 @@
 //!
 //! - [`emit`](self#emission): directions and powers (paper eq. 7, made uniform; projection maps),
 //! - `trace`: one photon's path,
-//! - `kdtree`: the left-balanced kd-tree built in place ([`KdTree`], [`balance`]),
+//! - `kdtree`: the kd-tree built in place, in-order with bucket leaves ([`KdTree`], [`balance`]),
 //! - `estimate`: the radiance estimate (Jensen; paper eq. 8).
 //!
 //! # Emission
@@ -24,9 +24,7 @@ pub use illumination::{
 };
 #[cfg(feature = "std")]
 pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
-pub use kdtree::{
-    balance, balance_finish, balance_subtree, balance_top, Found, KdTree, Neighbor, Subtree,
-};
+pub use kdtree::{balance, balance_subtree, balance_top, Found, KdTree, Neighbor, Subtree, BUCKET};
 pub use packed::Photon;
 pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 

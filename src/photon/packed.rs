@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | 0 | position x: `f32` rounded to 16 mantissa bits | direction bits 0–6 |
 //! | 1 | position y, likewise | direction bits 7–13 |
-//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), balancing scratch (1 bit), forward-pass half (1 bit), 1 spare |
+//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), 1 spare, forward-pass half (1 bit), 1 spare |
 //! | 3 | power: shared-exponent RGB (Ward's RGBE), relative to the map's power unit | |
 //!
 //! The direction of travel is an octahedral map, 8 bits per coordinate (Cigolle et
@@ -31,7 +31,6 @@ const PAYLOAD: u32 = 0x7f;
 /// Where the axis sits in word 2's payload.
 const AXIS_SHIFT: u32 = 2;
 const AXIS_BITS: u32 = 0b11 << AXIS_SHIFT;
-const SCRATCH_BIT: u32 = 1 << 4;
 const HALF_BIT: u32 = 1 << 5;
 
 /// `x` rounded to nearest at bit 7 of its pattern (a carry into the exponent is the
@@ -119,18 +118,6 @@ impl Photon {
     #[inline]
     pub(crate) fn set_axis(&mut self, axis: usize) {
         self.words[2] = (self.words[2] & !AXIS_BITS) | ((axis as u32) << AXIS_SHIFT);
-    }
-
-    /// The balancing pass's mark.
-    #[inline]
-    pub(crate) fn scratch(&self) -> bool {
-        self.words[2] & SCRATCH_BIT != 0
-    }
-
-    /// Sets or clears the balancing pass's mark.
-    #[inline]
-    pub(crate) fn set_scratch(&mut self, on: bool) {
-        self.words[2] = (self.words[2] & !SCRATCH_BIT) | if on { SCRATCH_BIT } else { 0 };
     }
 }
 
@@ -240,8 +227,7 @@ mod tests {
             let mut p = Photon::new(pos, dir, power).with_half(i % 3 == 0);
             for axis in [2, 0, 1] {
                 p.set_axis(axis);
-                p.set_scratch(axis == 0);
-                assert_eq!((p.axis(), p.scratch()), (axis, axis == 0));
+                assert_eq!(p.axis(), axis);
                 assert_eq!(p.half(), i % 3 == 0);
                 assert_eq!(p.direction(), decode_octahedral(encode_octahedral(dir)));
                 assert_eq!(p.power(), decode_rgbe(encode_rgbe(power)));
