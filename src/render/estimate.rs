@@ -12,9 +12,10 @@
 //! - the sub-pixel sampling's: in a supersampled pixel, the two checkerboard halves of
 //!   its grid ([`Sampling`](super::Sampling)) give `((m_a − m_b)/2)²`.
 //!
-//! In a supersampled pixel the checkerboard halves gather over disjoint halves of its
-//! preimage, so their difference holds the gathers' noise, which the pixel's split
-//! then leaves out. Not estimated, and stated where it is reported: the gather's bias
+//! In a supersampled pixel the checkerboard halves gather over halves of its
+//! preimage, so their difference holds part of the gathers' noise; the sub-pixels'
+//! splits, averaged, are carried as well, since a grown sub-pixel footprint overlaps
+//! its neighbours'. Not estimated, and stated where it is reported: the gather's bias
 //! where the ray differentials' linear
 //! preimage of the pixel departs from the true one (at a silhouette or a fold of the
 //! focus; a supersampled pixel's sub-pixels shrink it), and the error of a pixel whose

@@ -81,9 +81,12 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Pixel `(x, y)` as the mean of an `n × n` grid of sub-pixel rays. Its sampling
     /// error is estimated from the grid's two checkerboard halves `a`, `b` as
     /// `((m_a − m_b)/2)²` per channel: the batch-means estimate for two half-grids.
-    /// The halves gather over disjoint halves of the pixel's preimage, so this holds the
-    /// gathers' noise too, and the gathers' own [`split`](Sample::split) is left out
-    /// (it would count that noise twice).
+    /// The halves gather over halves of the pixel's preimage, so this holds part of the
+    /// gathers' noise; the sub-pixels' own [`split`](Sample::split)s, averaged, are
+    /// carried too, because a sub-pixel footprint that grew
+    /// ([`SPARSE_FOOTPRINT`](crate::photon::SPARSE_FOOTPRINT)) overlaps its neighbours
+    /// and the halves then share photons (without it the sphere + wall scene's estimate
+    /// fell to half its measured error).
     fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> PixelEstimate {
         let step = 1.0 / n as f32;
         let camera = self.scene.camera();
