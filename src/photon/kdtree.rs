@@ -217,7 +217,24 @@ impl<'a> KdTree<'a> {
     /// is scanned as a range of one, by the leaves' loop, so `visit` has one call site:
     /// inlined twice, a gather's kernel cost a Cortex-M4F 1 KiB of flash.
     #[inline]
-    pub fn search(&self, x: Vec3, mut radius2: f32, mut visit: impl FnMut(usize, f32) -> f32) {
+    pub fn search(&self, x: Vec3, radius2: f32, visit: impl FnMut(usize, f32) -> f32) {
+        self.search_boxed(x, radius2, [f32::INFINITY; 3], visit);
+    }
+
+    /// [`search`](Self::search) that also skips every part of the tree outside the box
+    /// `|p − x|ᵢ < sqrt(half2[i])` about `x`: a far side is kept only when its plane is
+    /// within both the radius and the box's half-extent on its axis. Photons inside the
+    /// box are visited in the same order as by `search`; some outside it are not
+    /// visited at all. A footprint gather passes the bounding box of its
+    /// parallelogram, which a ball about a thin one holds many times over.
+    #[inline]
+    pub fn search_boxed(
+        &self,
+        x: Vec3,
+        mut radius2: f32,
+        half2: [f32; 3],
+        mut visit: impl FnMut(usize, f32) -> f32,
+    ) {
         let photons = self.photons;
         // An array, not `Vec3`: glam indexes a `Vec3` by a `match`, an array by address.
         let xa = x.to_array();
@@ -240,7 +257,8 @@ impl<'a> KdTree<'a> {
                 let delta = plane(m);
                 // The far side can hold photons within reach only if its plane is (the
                 // radius may shrink at `m`: the pop tests again).
-                if delta * delta < radius2 {
+                let d2 = delta * delta;
+                if d2 < radius2 && d2 < half2[photons[m].axis()] {
                     // Cannot fail: one entry per split level above, ≤ MAX_DEPTH of them.
                     let _ = far.push(Far {
                         split: m as u32,
@@ -479,6 +497,28 @@ mod tests {
                 r2
             });
             assert_eq!(inside, brute_k_nearest(photons, x, r2, usize::MAX).len());
+            // A boxed search visits every photon in the box and the ball, in the order
+            // the plain search visits them, and fewer outside the box.
+            let h = Vec3::new(g.next_f32(), g.next_f32() * 0.1, g.next_f32() * 3.0);
+            let in_box = |i: usize| {
+                let d = (tree_photons[i].position() - x).abs();
+                d.x < h.x && d.y < h.y && d.z < h.z
+            };
+            let (mut plain, mut boxed, mut boxed_visits) = (Vec::new(), Vec::new(), 0);
+            tree.search(x, r2, |i, _| {
+                plain.extend(Some(i).filter(|&i| in_box(i)));
+                r2
+            });
+            tree.search_boxed(x, r2, (h * h).to_array(), |i, _| {
+                boxed_visits += 1;
+                boxed.extend(Some(i).filter(|&i| in_box(i)));
+                r2
+            });
+            assert_eq!(boxed, plain, "query {q}: the box's photons, in order");
+            assert!(
+                boxed_visits <= inside,
+                "query {q}: {boxed_visits} > {inside}"
+            );
         }
     }
 
