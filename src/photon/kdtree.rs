@@ -238,10 +238,11 @@ impl<'a> KdTree<'a> {
         let photons = self.photons;
         // An array, not `Vec3`: glam indexes a `Vec3` by a `match`, an array by address.
         let xa = x.to_array();
+        // A splitting photon's axis, and x's signed distance from its plane.
         let plane = |m: usize| {
             let p = &photons[m];
             let axis = p.axis();
-            xa[axis] - p.coord(axis)
+            (axis, xa[axis] - p.coord(axis))
         };
         let mut far: heapless::Vec<Far, MAX_DEPTH> = heapless::Vec::new();
         let (mut lo, mut hi) = (0usize, photons.len());
@@ -254,11 +255,11 @@ impl<'a> KdTree<'a> {
                 lo..hi
             } else {
                 let m = lo + (hi - lo) / 2;
-                let delta = plane(m);
+                let (axis, delta) = plane(m);
                 // The far side can hold photons within reach only if its plane is (the
                 // radius may shrink at `m`: the pop tests again).
                 let d2 = delta * delta;
-                if d2 < radius2 && d2 < half2[photons[m].axis()] {
+                if d2 < radius2 && d2 < half2[axis] {
                     // Cannot fail: one entry per split level above, ≤ MAX_DEPTH of them.
                     let _ = far.push(Far {
                         split: m as u32,
@@ -286,7 +287,7 @@ impl<'a> KdTree<'a> {
             loop {
                 let Some(next) = far.pop() else { return };
                 let split = next.split as usize;
-                let delta = plane(split);
+                let (_, delta) = plane(split);
                 if delta * delta < radius2 {
                     let end = next.end as usize;
                     (lo, hi) = if end > split {

@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | 0 | position x: `f32` rounded to 16 mantissa bits | direction bits 0–6 |
 //! | 1 | position y, likewise | direction bits 7–13 |
-//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), 1 spare, forward-pass half (1 bit), 1 spare |
+//! | 2 | position z, likewise | direction bits 14–15, kd-tree split axis (2 bits), forward-pass half (1 bit), 2 spare |
 //! | 3 | power: shared-exponent RGB (Ward's RGBE), relative to the map's power unit | |
 //!
 //! The direction of travel is an octahedral map, 8 bits per coordinate (Cigolle et
@@ -31,7 +31,7 @@ const PAYLOAD: u32 = 0x7f;
 /// Where the axis sits in word 2's payload.
 const AXIS_SHIFT: u32 = 2;
 const AXIS_BITS: u32 = 0b11 << AXIS_SHIFT;
-const HALF_BIT: u32 = 1 << 5;
+const HALF_BIT: u32 = 1 << 4;
 
 /// `x` rounded to nearest at bit 7 of its pattern (a carry into the exponent is the
 /// correct rounding); truncated instead where rounding would overflow to infinity.
