@@ -129,13 +129,14 @@ pub(crate) fn encode_rgbe(c: Rgb) -> [u8; 4] {
     if !(m > 1e-32) || !m.is_finite() {
         return [0; 4];
     }
-    // m = f · 2^e with f ∈ [0.5, 1): mantissas are channel · 256 / 2^e.
-    let (_, mut e) = libm::frexpf(m);
-    let mut scale = libm::ldexpf(256.0, -e);
+    // m = f · 2^e with f ∈ [0.5, 1) (`frexpf`; m is normal, so e is its biased
+    // exponent less 126, −106 ≤ e ≤ 128): mantissas are channel · 256 / 2^e.
+    let mut e = ((m.to_bits() >> 23) & 0xff) as i32 - 126;
+    let mut scale = pow2(8 - e);
     if (m * scale + 0.5) as u32 > 255 {
         // Rounding the largest channel up to 256 would overflow: use the next exponent.
         e += 1;
-        scale = libm::ldexpf(256.0, -e);
+        scale = pow2(8 - e);
     }
     let q = |x: f32| ((x * scale + 0.5) as u32).min(255) as u8;
     [q(c.r), q(c.g), q(c.b), (e + 128).clamp(0, 255) as u8]
@@ -145,8 +146,21 @@ pub(crate) fn decode_rgbe(v: [u8; 4]) -> Rgb {
     if v[3] == 0 {
         return Rgb::ZERO;
     }
-    let f = libm::ldexpf(1.0, v[3] as i32 - (128 + 8));
+    let f = pow2(v[3] as i32 - (128 + 8));
     Rgb::new(v[0] as f32 * f, v[1] as f32 * f, v[2] as f32 * f)
+}
+
+/// `2^k` exactly for `−149 ≤ k ≤ 127` (subnormal below −126), built from its bits:
+/// what `ldexpf(1, k)` returns, without its general scaling (a gather decodes one
+/// power per photon it sums).
+#[inline]
+fn pow2(k: i32) -> f32 {
+    debug_assert!((-149..=127).contains(&k));
+    if k >= -126 {
+        f32::from_bits(((k + 127) as u32) << 23)
+    } else {
+        f32::from_bits(1u32 << (k + 149))
+    }
 }
 
 /// Octahedral encoding of a unit vector in two bytes.
@@ -183,6 +197,70 @@ pub(crate) fn decode_octahedral(e: [u8; 2]) -> UnitVec3 {
 mod tests {
     use super::*;
     use crate::sampling::Pcg32;
+
+    #[test]
+    fn pow2_is_ldexpf_of_one_over_its_whole_range() {
+        for k in -149..=127 {
+            assert_eq!(pow2(k).to_bits(), libm::ldexpf(1.0, k).to_bits(), "2^{k}");
+        }
+    }
+
+    /// The encoding as first written, with `frexpf` and `ldexpf`: the bit-built one must
+    /// give the same bytes.
+    fn encode_rgbe_libm(c: Rgb) -> [u8; 4] {
+        let c = Rgb::new(c.r.max(0.0), c.g.max(0.0), c.b.max(0.0));
+        let m = c.max_channel();
+        if !(m > 1e-32) || !m.is_finite() {
+            return [0; 4];
+        }
+        let (_, mut e) = libm::frexpf(m);
+        let mut scale = libm::ldexpf(256.0, -e);
+        if (m * scale + 0.5) as u32 > 255 {
+            e += 1;
+            scale = libm::ldexpf(256.0, -e);
+        }
+        let q = |x: f32| ((x * scale + 0.5) as u32).min(255) as u8;
+        [q(c.r), q(c.g), q(c.b), (e + 128).clamp(0, 255) as u8]
+    }
+
+    #[test]
+    fn rgbe_bytes_are_those_of_frexpf_and_ldexpf() {
+        let mut rng = Pcg32::new(11);
+        let mut values = std::vec![
+            1e-32f32,
+            1.000_001e-32,
+            0.999_99,
+            1.0,
+            255.5 / 256.0,
+            f32::MAX
+        ];
+        for _ in 0..20_000 {
+            // Magnitudes across the whole encodable range, 2^-110 … 2^127.
+            let e = (rng.next_f32() * 237.0) as i32 - 110;
+            values.push(libm::ldexpf(0.5 + 0.5 * rng.next_f32(), e));
+        }
+        for &m in &values {
+            for c in [
+                Rgb::splat(m),
+                Rgb::new(m, 0.3 * m, 0.0),
+                Rgb::new(0.01 * m, m, -m),
+            ] {
+                assert_eq!(encode_rgbe(c), encode_rgbe_libm(c), "{c:?}");
+                let bytes = encode_rgbe(c);
+                let f = libm::ldexpf(1.0, bytes[3] as i32 - 136);
+                let want = if bytes[3] == 0 {
+                    Rgb::ZERO
+                } else {
+                    Rgb::new(
+                        bytes[0] as f32 * f,
+                        bytes[1] as f32 * f,
+                        bytes[2] as f32 * f,
+                    )
+                };
+                assert_eq!(decode_rgbe(bytes), want);
+            }
+        }
+    }
 
     #[test]
     fn rgbe_round_trips_within_half_a_mantissa_step() {
