@@ -395,7 +395,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         // more stops there and is tried again — a sliver cut into disks, then on the
         // next coarser level, at last scaled down. A sparse one grows once.
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
-        let level = self.first_level(x, n, &region);
+        let level = self.first_level(x, &region);
         let (mut region, mut level, mut cut) = (region, level, false);
         let mut grown = false;
         loop {
@@ -432,13 +432,23 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// The level to try first: the finest whose photons in the region's reach are
     /// predicted, from the coarsest level's count, not to exceed [`FOOTPRINT_VISITS`].
-    fn first_level(&self, x: Vec3, n: UnitVec3, region: &Region) -> usize {
+    /// The count is of the photons an uncut [`sum_in`](Self::sum_in) visits there (the
+    /// same walk), with nothing summed, and it stops as soon as it rules out level 1.
+    fn first_level(&self, x: Vec3, region: &Region) -> usize {
         let Some(coarsest) = self.coarse[1] else {
             return 0;
         };
-        let (_, visits, _) =
-            self.sum_in(Some(coarsest), x, n, region, false, &mut |_, _| Rgb::ZERO);
-        let Some(v) = visits else { return 2 };
+        let cap = FOOTPRINT_VISITS / THINNING;
+        let mut v = 0;
+        let half2 = region.box_half2(region.a, region.b, region.reach2);
+        coarsest.search_boxed(x, region.reach2, half2, |_, _| {
+            v += 1;
+            if v > cap {
+                0.0 // ends the search: level 2
+            } else {
+                region.reach2
+            }
+        });
         if v * THINNING * THINNING <= FOOTPRINT_VISITS {
             0
         } else if v * THINNING <= FOOTPRINT_VISITS {
