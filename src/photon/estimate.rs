@@ -375,7 +375,8 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
             // finds nothing, the same zero.
             let (mut region, mut grown) = (region, false);
             loop {
-                let (sum, _, found) = self.sum_in(Some(self.tree), x, n, &region, false, weight);
+                let (sum, _, found) =
+                    self.sum_in(Some(self.tree), x, n, &region, false, Some(weight));
                 match self.grown(&region, found).filter(|_| !grown) {
                     Some(larger) => (region, grown) = (larger, true),
                     None => {
@@ -395,11 +396,11 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         // more stops there and is tried again — a sliver cut into disks, then on the
         // next coarser level, at last scaled down. A sparse one grows once.
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
-        let level = self.first_level(x, &region);
+        let level = self.first_level(x, n, &region);
         let (mut region, mut level, mut cut) = (region, level, false);
         let mut grown = false;
         loop {
-            let (sum, visits, found) = self.sum_in(levels[level], x, n, &region, cut, weight);
+            let (sum, visits, found) = self.sum_in(levels[level], x, n, &region, cut, Some(weight));
             if visits.is_some() {
                 if let Some(larger) = self.grown(&region, found).filter(|_| level == 0 && !grown) {
                     (region, grown, cut) = (larger, true, false);
@@ -432,23 +433,14 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// The level to try first: the finest whose photons in the region's reach are
     /// predicted, from the coarsest level's count, not to exceed [`FOOTPRINT_VISITS`].
-    /// The count is of the photons an uncut [`sum_in`](Self::sum_in) visits there (the
-    /// same walk), with nothing summed, and it stops as soon as it rules out level 1.
-    fn first_level(&self, x: Vec3, region: &Region) -> usize {
+    /// The count is [`sum_in`](Self::sum_in)'s walk with nothing summed, stopped as soon
+    /// as it rules out level 1.
+    fn first_level(&self, x: Vec3, n: UnitVec3, region: &Region) -> usize {
         let Some(coarsest) = self.coarse[1] else {
             return 0;
         };
-        let cap = FOOTPRINT_VISITS / THINNING;
-        let mut v = 0;
-        let half2 = region.box_half2(region.a, region.b, region.reach2);
-        coarsest.search_boxed(x, region.reach2, half2, |_, _| {
-            v += 1;
-            if v > cap {
-                0.0 // ends the search: level 2
-            } else {
-                region.reach2
-            }
-        });
+        let (_, visits, _) = self.sum_in(Some(coarsest), x, n, region, false, None);
+        let Some(v) = visits else { return 2 };
         if v * THINNING * THINNING <= FOOTPRINT_VISITS {
             0
         } else if v * THINNING <= FOOTPRINT_VISITS {
@@ -460,7 +452,10 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// The weighted sums of the front-side photons of `tree` inside `region`, of the
     /// forward pass's half 0 and half 1, the photons visited (`None` when they would
-    /// exceed [`FOOTPRINT_VISITS`]) and the photons summed.
+    /// exceed [`FOOTPRINT_VISITS`]) and the photons summed. Without a `weight`, only
+    /// the visits are counted, and `None` once they exceed `FOOTPRINT_VISITS /
+    /// THINNING` (all [`first_level`](Self::first_level) needs; one walk serves both,
+    /// so a device's flash holds one copy of it).
     #[inline]
     fn sum_in(
         &self,
@@ -469,8 +464,13 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         n: UnitVec3,
         region: &Region,
         cut: bool,
-        weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
+        mut weight: Option<&mut dyn FnMut(UnitVec3, Rgb) -> Rgb>,
     ) -> ([Rgb; 2], Option<usize>, u32) {
+        let cap = if weight.is_some() {
+            FOOTPRINT_VISITS
+        } else {
+            FOOTPRINT_VISITS / THINNING
+        };
         let mut sum = [Rgb::ZERO; 2];
         let Some(tree) = tree else {
             return (sum, Some(0), 0);
@@ -513,9 +513,12 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
             let centre = x + long * (lo + 0.5 * step);
             tree.search_boxed(centre, reach2, half2, |index, _| {
                 visited += 1;
-                if visited > FOOTPRINT_VISITS {
+                if visited > cap {
                     return 0.0; // ends the search
                 }
+                let Some(weight) = weight.as_mut() else {
+                    return reach2;
+                };
                 let p = &photons[index];
                 let inside = region
                     .coords(p.position() - x)
@@ -532,7 +535,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                 }
                 reach2
             });
-            if visited > FOOTPRINT_VISITS {
+            if visited > cap {
                 return (sum, None, found);
             }
         }
@@ -664,7 +667,7 @@ mod tests {
             for cut in [false, true] {
                 let mut weight = |_: UnitVec3, p: Rgb| p;
                 let (sum, visits, found) =
-                    store.sum_in(Some(tree), x, normal, &region, cut, &mut weight);
+                    store.sum_in(Some(tree), x, normal, &region, cut, Some(&mut weight));
                 if visits.is_none() {
                     continue; // over the visit bound: the caller moves on
                 }
