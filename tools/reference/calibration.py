@@ -19,7 +19,12 @@ file's max_depth): no estimator hint. Usage (from the repository root, after
 `cargo build --release`):
 
     tools/reference/.venv/bin/python tools/reference/calibration.py [--size 320x240]
-        [--photons 25000,100000,400000,1600000] [--out docs/error_calibration]
+        [--photons 25000,100000,400000,1600000] [--out docs/error_calibration] [--own-noise]
+
+--own-noise renders every point a second time with seed 1 and adds the render's own
+seed-to-seed noise (columns own_noise_full, own_noise_caustic): what the error estimate's
+photon part estimates, measured without any reference, and a floor under the measured error
+that no better reference can lower.
 """
 import argparse
 import json
@@ -92,8 +97,9 @@ def reference(name, width):
     return full, region, ref_noise
 
 
-def render(scene_path, photons, width, height, binary):
-    """Render with a plain photons block; return (image, error_estimate, seconds)."""
+def render(scene_path, photons, width, height, binary, seed=0):
+    """Render with a plain photons block and forward-pass `seed` (caustic's default is 0);
+    return (image, error_estimate, seconds)."""
     js = json.load(open(os.path.join(REPO, scene_path)))
     depth = js.get("photons", {}).get("max_depth", 8)
     js["photons"] = {"count": photons, "k": 64, "max_radius": 0.25, "max_depth": depth}
@@ -102,12 +108,19 @@ def render(scene_path, photons, width, height, binary):
         out = os.path.join(tmp, "out.pfm")
         with open(scene, "w") as f:
             json.dump(js, f)
-        cmd = [binary, "render", scene, "-o", out, "--quiet", "--stats",
+        cmd = [binary, "render", scene, "-o", out, "--quiet", "--stats", "--seed", str(seed),
                "--width", str(width), "--height", str(height)]
         t0 = time.time()
         stats = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
         seconds = time.time() - t0
         return read_pfm(out), stats["error_estimate"], seconds
+
+
+def own_noise(a, b, ref, mask):
+    """The render's own noise from two independent seeds a, b: sqrt(mean((a-b)^2)/2) over the
+    mask, relative to the reference's mean there (the rel. RMSE one render has against its
+    expectation; needs no reference beyond the normalisation)."""
+    return float(np.sqrt(((a[mask] - b[mask]) ** 2).mean() / 2) / ref[mask].mean())
 
 
 def true_error(measured, ref_noise):
@@ -126,6 +139,13 @@ def measure(args):
                        true_full=true_error(mf, noise_full),
                        estimated_caustic=est["rel_rmse_caustic"], measured_caustic=mc,
                        ref_noise_caustic=noise_caustic, true_caustic=true_error(mc, noise_caustic))
+            if args.own_noise:
+                other, _, _ = render(path, n, args.width, args.height, args.binary, seed=1)
+                every = np.ones(region.shape, bool)
+                row.update(own_noise_full=own_noise(img, other, ref, every),
+                           own_noise_caustic=own_noise(img, other, ref, region))
+                print(f"{name:>18} {n:>8}: own noise (seeds 0, 1) full {row['own_noise_full']:.4f} "
+                      f"caustic {row['own_noise_caustic']:.4f}", flush=True)
             rows.append(row)
             print(f"{name:>18} {n:>8}: full est {row['estimated_full']:.4f} true {row['true_full']:.4f} "
                   f"(measured {mf:.4f}); caustic est {fmt(row['estimated_caustic'])} true "
@@ -236,6 +256,8 @@ def main(argv):
     ap.add_argument("--out", default=os.path.join(REPO, "docs", "error_calibration"))
     ap.add_argument("--binary", default=os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(REPO, "target")),
                                                      "release", "caustic"))
+    ap.add_argument("--own-noise", action="store_true",
+                    help="also render seed 1 and report the render's own seed-to-seed noise")
     args = ap.parse_args(argv)
     args.width, args.height = map(int, args.size.split("x"))
     args.photons = [int(x) for x in args.photons.split(",")]
