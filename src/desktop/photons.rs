@@ -12,7 +12,7 @@ use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
 use crate::error::within;
 use crate::photon::{
-    self, balance, photons_needed, Emitter, KdStore, KdTree, Landed, Photon, PhotonSettings, Splat,
+    self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
     THINNING,
 };
 use crate::scene::Scene;
@@ -134,8 +134,10 @@ impl PhotonBuffer {
             })
             .collect();
         progress.phase(pass, "photons", items.len());
-        let results: vec::Vec<Mutex<vec::Vec<Landed>>> =
-            items.iter().map(|_| Mutex::new(vec::Vec::new())).collect();
+        // Each chunk's photons and splats, kept apart: a `Landed` is three times a
+        // photon, and these buffers are written once and read once.
+        type Chunk = (vec::Vec<Photon>, vec::Vec<Splat>);
+        let results: vec::Vec<Mutex<Chunk>> = items.iter().map(|_| Mutex::default()).collect();
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
             for _ in 0..threads.clamp(1, items.len().max(1)) {
@@ -144,8 +146,12 @@ impl PhotonBuffer {
                     let Some(&(l, start, end)) = items.get(k) else {
                         break;
                     };
-                    let local: vec::Vec<Landed> =
-                        (start..end).filter_map(|i| emitter.land(l, i)).collect();
+                    let mut local: Chunk =
+                        (vec::Vec::with_capacity(CHUNK as usize), vec::Vec::new());
+                    for x in (start..end).filter_map(|i| emitter.land(l, i)) {
+                        local.0.push(x.photon);
+                        local.1.extend(x.splat);
+                    }
                     if let Ok(mut slot) = results[k].lock() {
                         *slot = local;
                     }
@@ -156,11 +162,10 @@ impl PhotonBuffer {
         let mut stored = 0;
         self.splats.clear();
         for r in results {
-            for x in r.into_inner().unwrap_or_default() {
-                self.photons[stored] = x.photon;
-                stored += 1;
-                self.splats.extend(x.splat);
-            }
+            let (photons, splats) = r.into_inner().unwrap_or_default();
+            self.photons[stored..stored + photons.len()].copy_from_slice(&photons);
+            stored += photons.len();
+            self.splats.extend_from_slice(&splats);
         }
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
