@@ -134,10 +134,16 @@ impl PhotonBuffer {
             })
             .collect();
         progress.phase(pass, "photons", items.len());
-        // Each chunk's photons and splats, kept apart: a `Landed` is three times a
-        // photon, and these buffers are written once and read once.
-        type Chunk = (vec::Vec<Photon>, vec::Vec<Splat>);
-        let results: vec::Vec<Mutex<Chunk>> = items.iter().map(|_| Mutex::default()).collect();
+        // Chunk k's photons land in its own stretch of the array — emission index
+        // `first(l) + start..`, at most one photon per emitted one — and are moved down
+        // into emission order after: no second buffer. Its splats go to its own list.
+        let mut rest = &mut self.photons[..needed];
+        let mut slots = vec::Vec::with_capacity(items.len());
+        for &(_, start, end) in &items {
+            let (slot, tail) = rest.split_at_mut((end - start) as usize);
+            slots.push(Mutex::new((slot, 0usize, vec::Vec::new())));
+            rest = tail;
+        }
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
             for _ in 0..threads.clamp(1, items.len().max(1)) {
@@ -146,25 +152,31 @@ impl PhotonBuffer {
                     let Some(&(l, start, end)) = items.get(k) else {
                         break;
                     };
-                    let mut local: Chunk =
-                        (vec::Vec::with_capacity(CHUNK as usize), vec::Vec::new());
-                    for x in (start..end).filter_map(|i| emitter.land(l, i)) {
-                        local.0.push(x.photon);
-                        local.1.extend(x.splat);
-                    }
-                    if let Ok(mut slot) = results[k].lock() {
-                        *slot = local;
+                    if let Ok(mut chunk) = slots[k].lock() {
+                        let (slot, len, splats) = &mut *chunk;
+                        for x in (start..end).filter_map(|i| emitter.land(l, i)) {
+                            slot[*len] = x.photon;
+                            *len += 1;
+                            splats.extend(x.splat);
+                        }
                     }
                     progress.tick();
                 });
             }
         });
-        let mut stored = 0;
+        let counts: vec::Vec<(usize, vec::Vec<Splat>)> = slots
+            .into_iter()
+            .map(|m| {
+                let (_, len, splats) = m.into_inner().unwrap_or_default();
+                (len, splats)
+            })
+            .collect();
+        let (mut stored, mut at) = (0, 0);
         self.splats.clear();
-        for r in results {
-            let (photons, splats) = r.into_inner().unwrap_or_default();
-            self.photons[stored..stored + photons.len()].copy_from_slice(&photons);
-            stored += photons.len();
+        for (&(_, start, end), (len, splats)) in items.iter().zip(counts) {
+            self.photons.copy_within(at..at + len, stored);
+            stored += len;
+            at += (end - start) as usize;
             self.splats.extend_from_slice(&splats);
         }
         stats.emit_ms += ms(t.elapsed());
