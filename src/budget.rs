@@ -396,6 +396,7 @@ mod tests {
             let f = Footprint {
                 a: Vec3::new(s, 0.0, 0.1 * s),
                 b: Vec3::new(-0.1 * s, 0.0, s * sliver),
+                throughput: 1.0,
             };
             let (e, c) = (
                 capped.irradiance_within(x, up, &f),

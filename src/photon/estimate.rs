@@ -40,6 +40,10 @@ pub struct Footprint {
     pub a: Vec3,
     /// Second half-axis (the image's y direction), scene units.
     pub b: Vec3,
+    /// The largest channel of the eye path's throughput up to the patch (the product of
+    /// the reflectances and transmittances on the way; 1 for an unattenuated path):
+    /// below [`FAINT`] the gather starts on a coarse level.
+    pub throughput: f32,
 }
 
 /// Most disks one footprint's search is cut into (see `Region::segments`).
@@ -203,6 +207,17 @@ pub const THINNING: usize = 16;
 /// photon there stands for [`THINNING`]ˡ of the map's), and beyond the coarsest it is
 /// scaled down about its centre.
 pub const FOOTPRINT_VISITS: usize = 1024;
+
+/// A footprint seen along a path of throughput below this — a reflection off glass
+/// near normal incidence (4%), or light that crossed a glass wall after reflecting
+/// inside it — is gathered on the first coarse level, every [`THINNING`]-th photon,
+/// each standing for that many: unbiased, and since the path weighs each of them by
+/// less than `1/THINNING` in the pixel, one adds less than one photon of a full-weight
+/// gather. No coarse-level prediction and no growth: one search over a tree
+/// `THINNING` times smaller. Chosen on the tuning scenes at 1.6M photons per light:
+/// gathers 31% (glass sphere) and 42% (two balls) faster with the same error; the
+/// tube's caustic region 0.0483 → 0.0504, in the same time.
+pub const FAINT: f32 = 1.0 / THINNING as f32;
 
 /// A footprint whose photons are fewer than this is gathered once more over the patch
 /// twice its size about the same centre (within the store's radius). Where the eye sees
@@ -394,9 +409,15 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         // The finest level where the footprint visits at most FOOTPRINT_VISITS
         // photons, as the coarsest level's count predicts it: a search that would visit
         // more stops there and is tried again — a sliver cut into disks, then on the
-        // next coarser level, at last scaled down. A sparse one grows once.
+        // next coarser level, at last scaled down. A sparse one grows once (on level 0).
+        // A faint path's starts on level 1 (see FAINT).
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
-        let level = self.first_level(x, n, &region);
+        let faint = footprint.throughput < FAINT && self.coarse[0].is_some();
+        let level = if faint {
+            1
+        } else {
+            self.first_level(x, n, &region)
+        };
         let (mut region, mut level, mut cut) = (region, level, false);
         let mut grown = false;
         loop {
@@ -623,6 +644,52 @@ mod tests {
     use crate::sampling::Pcg32;
     use std::vec::Vec;
 
+    /// A footprint on a faint path is the brute-force sum over the first coarse level's
+    /// photons inside it, each counted [`THINNING`] times; the same footprint on a
+    /// full-weight path reads the map itself.
+    #[test]
+    fn a_faint_footprint_is_gathered_on_the_first_coarse_level() {
+        let mut g = Pcg32::new(5);
+        let up = UnitVec3::Y;
+        let mut photons: Vec<Photon> = (0..64_000)
+            .map(|i| {
+                let p = Vec3::new(g.next_f32() * 4.0 - 2.0, 0.0, g.next_f32() * 4.0 - 2.0);
+                let power = Rgb::splat(1.0 + g.next_f32());
+                Photon::new(p, -up, power).with_half(i % 2 == 0)
+            })
+            .collect();
+        let mut level1: Vec<Photon> = photons.iter().step_by(THINNING).copied().collect();
+        let mut level2: Vec<Photon> = level1.iter().step_by(THINNING).copied().collect();
+        for level in [&mut photons, &mut level1, &mut level2] {
+            balance(level);
+        }
+        let tree = KdTree::from_balanced(&photons);
+        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None)
+            .with_coarse_levels(KdTree::from_balanced(&level1), KdTree::from_balanced(&level2));
+        let brute = |level: &[Photon], x: Vec3, f: &Footprint| {
+            let region = Region::new(f, 1.0).unwrap();
+            let inside = level.iter().filter(|p| region.coords(p.position() - x).is_some());
+            (inside.map(|p| p.power().r).sum::<f32>(), region.area)
+        };
+        let mut differ = 0;
+        for q in 0..100 {
+            let x = Vec3::new(g.next_f32() - 0.5, 0.0, g.next_f32() - 0.5);
+            let s = 0.05 + 0.1 * g.next_f32();
+            let (a, b) = (Vec3::new(s, 0.0, 0.2 * s), Vec3::new(-0.3 * s, 0.0, 0.7 * s));
+            let faint = Footprint { a, b, throughput: 0.5 * FAINT };
+            let (sum, area) = brute(&level1, x, &faint);
+            let want = sum * THINNING as f32 / area;
+            let got = store.irradiance_within(x, up, &faint).total.r;
+            assert!((got - want).abs() <= 1e-4 * want.max(1.0), "footprint {q}: {got} {want}");
+            let full = Footprint { throughput: 1.0, ..faint };
+            let (sum, area) = brute(&photons, x, &full);
+            let fine = store.irradiance_within(x, up, &full).total.r;
+            assert!((fine - sum / area).abs() <= 1e-4 * fine.max(1.0), "footprint {q}");
+            differ += (fine != got) as u32;
+        }
+        assert!(differ > 90, "the faint gathers read the map itself: {differ}");
+    }
+
     /// Every footprint's sums — one search or cut into disks, with the box that prunes
     /// the walk — are the brute-force sums over the photons inside its parallelogram
     /// that arrived on the front: photons near a tilted plane, some off it, some arriving
@@ -658,6 +725,7 @@ mod tests {
             let short = (v.get() * c - u.get() * s) * [1.0, 0.2, 0.02][q % 3] * g.next_f32();
             let shear = long * (g.next_f32() - 0.5);
             let fp = Footprint {
+                throughput: 1.0,
                 a: long,
                 b: short + shear,
             };

@@ -17,7 +17,9 @@ mod packed;
 mod splat;
 mod trace;
 
-pub use estimate::{ConeFilter, Footprint, KdStore, FOOTPRINT_VISITS, SPARSE_FOOTPRINT, THINNING};
+pub use estimate::{
+    ConeFilter, Footprint, KdStore, FAINT, FOOTPRINT_VISITS, SPARSE_FOOTPRINT, THINNING,
+};
 
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,

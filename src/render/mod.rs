@@ -405,9 +405,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         }
         let (camera, objects) = (self.scene.camera(), self.scene.objects());
         let diffs = trail.differentials(camera, objects, b.depth, (b.ray.dir, b.bend));
+        let throughput = b.weight.max_channel();
         let [a, b] =
             diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
-        Gather::Footprint(Footprint { a, b })
+        Gather::Footprint(Footprint { a, b, throughput })
     }
 
     /// Light leaving `hit` towards the eye directly, and up to two specular branches
