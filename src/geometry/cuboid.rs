@@ -1,6 +1,6 @@
 //! The rotated box (the paper's "cube").
 
-use super::{error_bound, BoundingSphere, Hit, Ray};
+use super::{error_bound, reject_radius2, surely_missed, BoundingSphere, Hit, Ray};
 use crate::error::{positive, Error};
 use crate::math::{finite_vec, max_abs, sin_cos_turns, Mat3, UnitVec3, Vec3};
 
@@ -35,7 +35,7 @@ impl Cuboid {
         let rotation = rotation_zyx(turns);
         let half = size * 0.5;
         let error = error_bound(max_abs(center) + half.length());
-        let reject_r = half.length() * (1.0 + 1e-4) + error;
+
         let mut normals = [[UnitVec3::X; 2]; 3];
         for (axis, pair) in normals.iter_mut().enumerate() {
             for (side, sign) in [-1.0f32, 1.0].into_iter().enumerate() {
@@ -47,7 +47,7 @@ impl Cuboid {
             half,
             rotation,
             inverse: rotation.transpose(),
-            reject_r2: reject_r * reject_r,
+            reject_r2: reject_radius2(half.length(), error),
             normals,
             error,
         })
@@ -77,18 +77,11 @@ impl Cuboid {
     }
 
     /// `true` when the ray cannot meet the box before `t_max`, by its bounding
-    /// sphere: the ray starts outside the sphere and points away from it, passes it by,
-    /// or reaches it only beyond `t_max`. About a dozen instructions instead of the
-    /// slab test's sixty; most rays of a scene miss most boxes.
+    /// sphere ([`surely_missed`]): about a dozen instructions instead of the slab
+    /// test's sixty.
     #[inline]
     fn surely_missed(&self, ray: &Ray, t_max: f32) -> bool {
-        let f = ray.origin - self.center;
-        let b = f.dot(ray.dir.get());
-        let c = f.length_squared() - self.reject_r2;
-        // Outside (c > 0) and moving away (b ≥ 0) or passing beside (b² < c); or the
-        // sphere's entry −b − √(b² − c) ≥ −b − R (as b² ≤ |f|²) lies beyond t_max.
-        let beyond = -b - t_max;
-        c > 0.0 && (b >= 0.0 || b * b < c || (beyond > 0.0 && beyond * beyond > self.reject_r2))
+        surely_missed(self.center, self.reject_r2, ray, t_max)
     }
 
     /// The slab interval `(t_near, near_axis, t_far, far_axis)` of the ray in the box's

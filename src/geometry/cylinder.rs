@@ -1,6 +1,6 @@
 //! The capped cylinder (the paper's "tube").
 
-use super::{error_bound, stable_roots, BoundingSphere, Hit, Ray};
+use super::{error_bound, reject_radius2, stable_roots, surely_missed, BoundingSphere, Hit, Ray};
 use crate::error::{positive, Error};
 use crate::math::{finite_vec, max_abs, UnitVec3, Vec3};
 
@@ -17,6 +17,10 @@ pub struct Cylinder {
     height: f32,
     capped: bool,
     error: f32,
+    /// The centre of the bounding sphere and its squared radius, widened
+    /// ([`reject_radius2`]): rays that surely miss it are turned away first.
+    center: Vec3,
+    reject_r2: f32,
 }
 
 impl Cylinder {
@@ -29,6 +33,7 @@ impl Cylinder {
         let height = positive(height, "cylinder height")?;
         let (e1, e2) = axis.basis();
         let error = error_bound(max_abs(base) + radius + height);
+        let h = 0.5 * height;
         Ok(Self {
             base,
             axis,
@@ -38,6 +43,8 @@ impl Cylinder {
             height,
             capped: true,
             error,
+            center: base + axis.get() * h,
+            reject_r2: reject_radius2(libm::sqrtf(h * h + radius * radius), error),
         })
     }
 
@@ -75,7 +82,7 @@ impl Cylinder {
     pub fn bounding_sphere(&self) -> BoundingSphere {
         let h = 0.5 * self.height;
         BoundingSphere {
-            center: self.base + self.axis.get() * h,
+            center: self.center,
             radius: libm::sqrtf(h * h + self.radius * self.radius),
         }
     }
@@ -85,9 +92,13 @@ impl Cylinder {
     /// In the frame `(e1, e2, axis)` the side is `x² + y² = r²`, `0 ≤ z ≤ h`: with
     /// `a = dx² + dy²`, `b = ox·dx + oy·dy`, `c = ox² + oy² − r²` the roots solve
     /// `a t² + 2b t + c = 0`, with the cancellation-free discriminant
-    /// `a·(r² − |o⊥ − (b/a)·d⊥|²)`. Caps are disks at `z = 0` and `z = h`.
+    /// `a·(r² − |o⊥ − (b/a)·d⊥|²)`. Caps are disks at `z = 0` and `z = h`. A ray that
+    /// surely misses the bounding sphere is turned away before any of this.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        if surely_missed(self.center, self.reject_r2, ray, t_max) {
+            return None;
+        }
         let rel = ray.origin - self.base;
         let d = ray.dir.get();
         let (ox, oy, oz) = (self.e1.dot(rel), self.e2.dot(rel), self.axis.dot(rel));

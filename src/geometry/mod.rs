@@ -92,6 +92,31 @@ impl Hit {
     }
 }
 
+/// The squared radius of a rejection sphere about a shape whose bounding sphere has
+/// `radius`: widened by 10⁻⁴ (relative) and the shape's error bound, so that rounding
+/// never rejects a ray the shape's own test would find a hit on.
+#[inline]
+pub(crate) fn reject_radius2(radius: f32, error: f32) -> f32 {
+    let r = radius * (1.0 + 1e-4) + error;
+    r * r
+}
+
+/// `true` when the ray cannot meet anything inside the sphere (`center`, radius²
+/// `r2`) before `t_max`: it starts outside and points away from it, passes it by, or
+/// reaches it only beyond `t_max`. About a dozen instructions; most rays of a scene miss
+/// most bounded shapes, and a box's slabs or a cylinder's quadratic and caps cost
+/// five times as many.
+#[inline]
+pub(crate) fn surely_missed(center: Vec3, r2: f32, ray: &Ray, t_max: f32) -> bool {
+    let f = ray.origin - center;
+    let b = f.dot(ray.dir.get());
+    let c = f.length_squared() - r2;
+    // Outside (c > 0) and moving away (b ≥ 0) or passing beside (b² < c); or the
+    // sphere's entry −b − √(b² − c) ≥ −b − R (as b² ≤ |f|²) lies beyond t_max.
+    let beyond = -b - t_max;
+    c > 0.0 && (b >= 0.0 || b * b < c || (beyond > 0.0 && beyond * beyond > r2))
+}
+
 /// A sphere that contains a shape: the basis of the photon projection maps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoundingSphere {
