@@ -664,30 +664,53 @@ mod tests {
             balance(level);
         }
         let tree = KdTree::from_balanced(&photons);
-        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None)
-            .with_coarse_levels(KdTree::from_balanced(&level1), KdTree::from_balanced(&level2));
+        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None).with_coarse_levels(
+            KdTree::from_balanced(&level1),
+            KdTree::from_balanced(&level2),
+        );
         let brute = |level: &[Photon], x: Vec3, f: &Footprint| {
             let region = Region::new(f, 1.0).unwrap();
-            let inside = level.iter().filter(|p| region.coords(p.position() - x).is_some());
+            let inside = level
+                .iter()
+                .filter(|p| region.coords(p.position() - x).is_some());
             (inside.map(|p| p.power().r).sum::<f32>(), region.area)
         };
         let mut differ = 0;
         for q in 0..100 {
             let x = Vec3::new(g.next_f32() - 0.5, 0.0, g.next_f32() - 0.5);
             let s = 0.05 + 0.1 * g.next_f32();
-            let (a, b) = (Vec3::new(s, 0.0, 0.2 * s), Vec3::new(-0.3 * s, 0.0, 0.7 * s));
-            let faint = Footprint { a, b, throughput: 0.5 * FAINT };
+            let (a, b) = (
+                Vec3::new(s, 0.0, 0.2 * s),
+                Vec3::new(-0.3 * s, 0.0, 0.7 * s),
+            );
+            let faint = Footprint {
+                a,
+                b,
+                throughput: 0.5 * FAINT,
+            };
             let (sum, area) = brute(&level1, x, &faint);
             let want = sum * THINNING as f32 / area;
             let got = store.irradiance_within(x, up, &faint).total.r;
-            assert!((got - want).abs() <= 1e-4 * want.max(1.0), "footprint {q}: {got} {want}");
-            let full = Footprint { throughput: 1.0, ..faint };
+            assert!(
+                (got - want).abs() <= 1e-4 * want.max(1.0),
+                "footprint {q}: {got} {want}"
+            );
+            let full = Footprint {
+                throughput: 1.0,
+                ..faint
+            };
             let (sum, area) = brute(&photons, x, &full);
             let fine = store.irradiance_within(x, up, &full).total.r;
-            assert!((fine - sum / area).abs() <= 1e-4 * fine.max(1.0), "footprint {q}");
+            assert!(
+                (fine - sum / area).abs() <= 1e-4 * fine.max(1.0),
+                "footprint {q}"
+            );
             differ += (fine != got) as u32;
         }
-        assert!(differ > 90, "the faint gathers read the map itself: {differ}");
+        assert!(
+            differ > 90,
+            "the faint gathers read the map itself: {differ}"
+        );
     }
 
     /// Every footprint's sums — one search or cut into disks, with the box that prunes
