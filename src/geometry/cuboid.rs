@@ -35,7 +35,6 @@ impl Cuboid {
         let rotation = rotation_zyx(turns);
         let half = size * 0.5;
         let error = error_bound(max_abs(center) + half.length());
-
         let mut normals = [[UnitVec3::X; 2]; 3];
         for (axis, pair) in normals.iter_mut().enumerate() {
             for (side, sign) in [-1.0f32, 1.0].into_iter().enumerate() {

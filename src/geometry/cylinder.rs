@@ -33,8 +33,7 @@ impl Cylinder {
         let height = positive(height, "cylinder height")?;
         let (e1, e2) = axis.basis();
         let error = error_bound(max_abs(base) + radius + height);
-        let h = 0.5 * height;
-        Ok(Self {
+        let mut cylinder = Self {
             base,
             axis,
             e1,
@@ -43,9 +42,11 @@ impl Cylinder {
             height,
             capped: true,
             error,
-            center: base + axis.get() * h,
-            reject_r2: reject_radius2(libm::sqrtf(h * h + radius * radius), error),
-        })
+            center: base + axis.get() * (0.5 * height),
+            reject_r2: 0.0,
+        };
+        cylinder.reject_r2 = reject_radius2(cylinder.bounding_sphere().radius, error);
+        Ok(cylinder)
     }
 
     /// The same cylinder closed by its two disks (`true`) or an open tube (`false`).
