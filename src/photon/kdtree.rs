@@ -208,10 +208,11 @@ impl<'a> KdTree<'a> {
     /// from `x`; `visit` returns the (possibly smaller) radius² to search on with, and
     /// a radius² of 0 (or NaN) ends the search.
     ///
-    /// Depth first from the root: each splitting photon on the way is visited, and the
-    /// walk goes on into the child on `x`'s side of its plane, keeping the other child
-    /// on a stack when the plane is within reach (at most one per split level: a fixed
-    /// 29 entries of 8 bytes, never zeroed). A leaf is scanned in order; then
+    /// Depth first from the root: each splitting photon on the way is tested when its
+    /// plane is within reach (it can be no nearer), and the walk goes on into the child
+    /// on `x`'s side of its plane, keeping the other child on a stack when the plane is
+    /// within reach (at most one per split level: a fixed 29 entries of 8 bytes, never
+    /// zeroed). A leaf is scanned in order; then
     /// the deepest kept far side whose plane is still within the current radius —
     /// recomputed, as a k-nearest search shrinks it — is searched. A splitting photon
     /// is scanned as a range of one, by the leaves' loop, so `visit` has one call site:
@@ -267,7 +268,14 @@ impl<'a> KdTree<'a> {
                     });
                 }
                 (lo, hi) = if delta < 0.0 { (lo, m) } else { (m + 1, hi) };
-                m..m + 1
+                // The splitting photon is no nearer than its plane: its rounded squared
+                // distance is a sum of non-negative terms, `d2` one of them. Beyond the
+                // radius it is not read (most of a small search's descent).
+                if d2 < radius2 {
+                    m..m + 1
+                } else {
+                    m..m
+                }
             };
             let first = scan.start;
             for (i, p) in photons[scan].iter().enumerate() {
