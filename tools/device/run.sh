@@ -72,17 +72,7 @@ if [[ -n "$only" ]]; then
 fi
 
 # --- tools -------------------------------------------------------------------------
-need_apt=()
-command -v qemu-system-arm >/dev/null || need_apt+=(qemu-system-arm)
-command -v qemu-system-riscv32 >/dev/null || need_apt+=(qemu-system-misc)
-if (( ${#need_apt[@]} )); then
-    if [[ $(id -u) == 0 ]] && command -v apt-get >/dev/null; then
-        step "installing ${need_apt[*]} (Debian packages)"
-        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_apt[@]}" >/dev/null
-    else
-        echo "run.sh: missing ${need_apt[*]} (Debian: apt-get install ${need_apt[*]})" >&2; exit 1
-    fi
-fi
+"$root/tools/device/install-qemu"
 installed="$(rustup target list --installed 2>/dev/null)"
 for f in "${firmwares[@]}"; do
     IFS='|' read -r _ target _ _ _ <<<"$f"
