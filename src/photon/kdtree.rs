@@ -267,7 +267,20 @@ impl<'a> KdTree<'a> {
                         end: if delta < 0.0 { hi } else { lo } as u32,
                     });
                 }
-                (lo, hi) = if delta < 0.0 { (lo, m) } else { (m + 1, hi) };
+                // Into the child on x's side: a branch, not a select. With a select
+                // (`cmov`) each level waits for its splitting photon's load before the
+                // next can start; a branch is predicted, and the next level's load
+                // starts at once. Successive gathers (the sub-pixels of a pixel, its
+                // neighbours) descend the same way, so the prediction is mostly right.
+                // [`cold`] only keeps the compiler from turning the branch into a
+                // select (either arm will do): the gathers' time on the tuning scenes
+                // at 1.6M photons a light fell 10–33%.
+                if delta < 0.0 {
+                    cold();
+                    hi = m;
+                } else {
+                    lo = m + 1;
+                }
                 // The splitting photon is no nearer than its plane: its rounded squared
                 // distance is a sum of non-negative terms, `d2` one of them. Beyond the
                 // radius it is not read (most of a small search's descent).
@@ -358,6 +371,13 @@ impl<'a> KdTree<'a> {
         Found { count, radius2 }
     }
 }
+
+/// Marks the branch it is called in as the unlikely one: the compiler then keeps the
+/// branch instead of a select (`core::hint::cold_path` from Rust 1.95; this form, as in
+/// hashbrown, builds on the crate's minimum Rust).
+#[inline(always)]
+#[cold]
+fn cold() {}
 
 /// A far side a search has still to visit: the child of the range split at `split`
 /// that ends at `end`, i.e. `split + 1..end` when `end > split`, else `end..split`.
