@@ -212,11 +212,11 @@ impl<'a> KdTree<'a> {
     /// plane is within reach (it can be no nearer), and the walk goes on into the child
     /// on `x`'s side of its plane, keeping the other child on a stack when the plane is
     /// within reach (at most one per split level: a fixed 29 entries of 8 bytes, never
-    /// zeroed). A leaf is scanned in order; then
-    /// the deepest kept far side whose plane is still within the current radius —
-    /// recomputed, as a k-nearest search shrinks it — is searched. A splitting photon
-    /// is scanned as a range of one, by the leaves' loop, so `visit` has one call site:
-    /// inlined twice, a gather's kernel cost a Cortex-M4F 1 KiB of flash.
+    /// zeroed). A leaf is scanned in order; then the deepest kept far side whose plane
+    /// is still within the current radius — recomputed, as a k-nearest search shrinks
+    /// it — is searched. A splitting photon is scanned as a range of one, by the
+    /// leaves' loop, so `visit` has one call site: inlined twice, a gather's kernel cost
+    /// a Cortex-M4F 1 KiB of flash.
     #[inline]
     pub fn search(&self, x: Vec3, radius2: f32, visit: impl FnMut(usize, f32) -> f32) {
         self.search_boxed(x, radius2, [f32::INFINITY; 3], visit);
