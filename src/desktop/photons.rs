@@ -3,7 +3,7 @@
 //! [`photon::shoot_with_splats`] and [`balance`] whatever the thread count.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 use std::vec;
 
@@ -13,7 +13,7 @@ use super::MAX_PHOTONS;
 use crate::error::within;
 use crate::photon::{
     self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
-    THINNING,
+    Subtree, THINNING,
 };
 use crate::scene::Scene;
 use crate::Error;
@@ -40,47 +40,104 @@ pub(super) fn desktop_budget<const O: usize, const L: usize>(
     within(needed, MAX_PHOTONS, "photons (count × lights)")
 }
 
-/// Balances the kd-tree on `threads` threads: the top levels on this one, then the
-/// subtrees below them — disjoint ranges of the array — on all. The same array as
-/// [`balance`], bit for bit.
-fn balance_parallel(photons: &mut [Photon], threads: usize, pass: u32, progress: &Progress) {
+/// Balances the kd-tree and its coarse levels on `threads` threads, the same arrays
+/// as [`balance`] makes, bit for bit. A pool of jobs: the root is split on one thread
+/// while another balances the coarse levels; each split hands out its two children,
+/// down to the fourth level of subtrees per thread, which are balanced whole.
+fn balance_parallel(
+    photons: &mut [Photon],
+    coarse: &mut [vec::Vec<Photon>],
+    threads: usize,
+    pass: u32,
+    progress: &Progress,
+) {
     // Below this a thread costs more than it saves.
     const SERIAL: usize = 1 << 15;
     if threads <= 1 || photons.len() < SERIAL {
         progress.phase(pass, "balance", 1);
+        for level in coarse.iter_mut() {
+            balance(level);
+        }
         balance(photons);
         progress.tick();
         return;
     }
-    let mut subtrees = vec::Vec::new();
     // Four subtrees per thread, rounded up to a level: balances the load.
     let levels = usize::BITS - (4 * threads - 1).leading_zeros();
-    progress.phase(pass, "balance", 0);
-    photon::balance_top(photons, levels, |t| subtrees.push(t));
-    subtrees.sort_by_key(|t| t.lo);
-    progress.set_steps(subtrees.len());
-    // Cut the array into the subtrees' disjoint slices.
-    let mut work = vec::Vec::with_capacity(subtrees.len());
-    let mut rest = &mut *photons;
-    let mut at = 0;
-    for t in subtrees {
-        let (_, tail) = rest.split_at_mut(t.lo - at);
-        let (slice, tail) = tail.split_at_mut(t.hi - t.lo);
-        work.push((slice, t));
-        rest = tail;
-        at = t.hi;
-    }
-    let work = Mutex::new(work);
+    progress.phase(pass, "balance", 1 << levels);
+    let mut jobs: vec::Vec<Job<'_>> = coarse.iter_mut().map(Job::Whole).collect();
+    jobs.push(Job::Part(photons, Subtree::root(photons.len())));
+    let pool = Pool {
+        queue: Mutex::new((jobs, 0)),
+        ready: Condvar::new(),
+    };
     std::thread::scope(|scope| {
         for _ in 0..threads {
-            scope.spawn(|| loop {
-                let next = work.lock().map(|mut w| w.pop()).unwrap_or(None);
-                let Some((slice, t)) = next else { break };
-                photon::balance_subtree(slice, t);
-                progress.tick();
+            scope.spawn(|| {
+                while let Some(job) = pool.take() {
+                    match job {
+                        Job::Whole(level) => balance(level),
+                        Job::Part(slice, t) if t.depth < levels => {
+                            pool.add(photon::split_subtree(slice, t).into_iter().flatten());
+                        }
+                        Job::Part(slice, t) => {
+                            photon::balance_subtree(slice, t);
+                            progress.tick();
+                        }
+                    }
+                    pool.done();
+                }
             });
         }
     });
+}
+
+/// A job of [`balance_parallel`].
+enum Job<'a> {
+    /// A coarse level, balanced whole.
+    Whole(&'a mut vec::Vec<Photon>),
+    /// A subtree of the map: split, or balanced whole at the bottom level.
+    Part(&'a mut [Photon], Subtree),
+}
+
+/// The jobs waiting and the number being done, and a signal for either's change.
+struct Pool<'a> {
+    queue: Mutex<(vec::Vec<Job<'a>>, usize)>,
+    ready: Condvar,
+}
+
+impl<'a> Pool<'a> {
+    /// The next job, waiting while others may still add some; `None` when none is
+    /// left and none is being done.
+    fn take(&self) -> Option<Job<'a>> {
+        let mut q = self.queue.lock().ok()?;
+        loop {
+            if let Some(job) = q.0.pop() {
+                q.1 += 1;
+                return Some(job);
+            }
+            if q.1 == 0 {
+                return None;
+            }
+            q = self.ready.wait(q).ok()?;
+        }
+    }
+
+    /// Adds the jobs a split made.
+    fn add(&self, parts: impl Iterator<Item = (&'a mut [Photon], Subtree)>) {
+        if let Ok(mut q) = self.queue.lock() {
+            q.0.extend(parts.map(|(slice, t)| Job::Part(slice, t)));
+        }
+        self.ready.notify_all();
+    }
+
+    /// Marks a job taken by [`take`](Self::take) done.
+    fn done(&self) {
+        if let Ok(mut q) = self.queue.lock() {
+            q.1 -= 1;
+        }
+        self.ready.notify_all();
+    }
 }
 
 /// Photons traced per work item of the parallel forward pass. Fixed, so that the order
@@ -194,10 +251,8 @@ impl PhotonBuffer {
         };
         let level2 = thin(&level1);
         self.coarse = [level1, level2];
-        for level in &mut self.coarse {
-            balance(level);
-        }
-        balance_parallel(&mut self.photons[..stored], threads, pass, progress);
+        let (photons, coarse) = (&mut self.photons[..stored], &mut self.coarse);
+        balance_parallel(photons, coarse, threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
         stats.photons_stored += stored as u64;

@@ -49,8 +49,7 @@ const _: () = assert!(BUCKET >= 2);
 
 /// Balances `photons` in place into the kd-tree [`KdTree::from_balanced`] reads.
 pub fn balance(photons: &mut [Photon]) {
-    let whole = Subtree::whole(photons.len());
-    partition(photons, 0, whole, u32::MAX, &mut |_| {});
+    partition(photons, 0, Subtree::root(photons.len()));
 }
 
 /// A subtree still to be partitioned: the range `lo..hi` of the whole array, `depth`
@@ -66,7 +65,8 @@ pub struct Subtree {
 }
 
 impl Subtree {
-    fn whole(n: usize) -> Self {
+    /// The whole array of `n` photons: the root.
+    pub fn root(n: usize) -> Self {
         Subtree {
             lo: 0,
             hi: n,
@@ -75,34 +75,85 @@ impl Subtree {
     }
 }
 
-/// The parallel form of [`balance`], in two steps for a caller that has threads (the
-/// core has none): [`balance_top`] partitions the top `levels` levels and hands out
-/// the subtrees below them that still need splitting, which occupy disjoint ranges
-/// `lo..hi`; the caller balances each with [`balance_subtree`] on its own slice, in
-/// any order or at once. The result is the array [`balance`] makes, bit for bit: each
-/// range is partitioned by the same steps on the same photons whoever does it.
-pub fn balance_top(photons: &mut [Photon], levels: u32, mut pending: impl FnMut(Subtree)) {
-    let whole = Subtree::whole(photons.len());
-    partition(photons, 0, whole, levels, &mut pending);
+/// One step of [`balance`], for a caller that has threads (the core has none): splits
+/// subtree `t` — `photons` is the whole array's slice `t.lo..t.hi` — at its median and
+/// returns its two children, each with its own slice; `None` for a leaf. Children
+/// split further, or balanced with [`balance_subtree`], in any order and on any
+/// thread, give the array [`balance`] makes, bit for bit: each range is partitioned
+/// by the same steps on the same photons whoever does it.
+pub fn split_subtree(photons: &mut [Photon], t: Subtree) -> Option<[(&mut [Photon], Subtree); 2]> {
+    debug_assert_eq!(photons.len(), t.hi - t.lo);
+    if photons.len() <= BUCKET {
+        return None;
+    }
+    let mid = split(photons);
+    let (left, right) = photons.split_at_mut(mid);
+    let (m, depth) = (t.lo + mid, t.depth + 1);
+    Some([
+        (
+            left,
+            Subtree {
+                lo: t.lo,
+                hi: m,
+                depth,
+            },
+        ),
+        (
+            &mut right[1..],
+            Subtree {
+                lo: m + 1,
+                hi: t.hi,
+                depth,
+            },
+        ),
+    ])
 }
 
-/// Balances subtree `t` handed out by [`balance_top`]; `photons` is the whole array's
-/// slice `t.lo..t.hi`.
+/// Balances subtree `t`; `photons` is the whole array's slice `t.lo..t.hi`.
 pub fn balance_subtree(photons: &mut [Photon], t: Subtree) {
     debug_assert_eq!(photons.len(), t.hi - t.lo);
-    partition(photons, t.lo, t, u32::MAX, &mut |_| {});
+    partition(photons, t.lo, t);
 }
 
-/// Partitions `start` and the subtrees below it down to (not including) depth `stop`,
-/// handing the ranges at depth `stop` that still need splitting to `pending`.
-/// `photons` holds the positions `base..base + photons.len()` of the whole array.
-fn partition(
-    photons: &mut [Photon],
-    base: usize,
-    start: Subtree,
-    stop: u32,
-    pending: &mut dyn FnMut(Subtree),
-) {
+/// Splits a range longer than [`BUCKET`] at its middle `⌊len/2⌋`, which it returns:
+/// the median along the longest axis of the range's bounding box, tagged with that
+/// axis.
+fn split(range: &mut [Photon]) -> usize {
+    let mid = range.len() / 2;
+    let axis = longest_axis(range);
+    select_median(range, mid, axis);
+    range[mid].set_axis(axis);
+    mid
+}
+
+/// Puts the photon of rank `mid` along `axis` at `mid`, those at or below it before
+/// and those at or above after (`select_nth_unstable` by the coordinate's total
+/// order). With `std`, one select per axis, each reading a fixed word: its inner loop
+/// loads one word per photon instead of indexing by a variable axis (the desktop's
+/// balance 10% faster); a device's flash holds one copy (three cost 6 KiB).
+#[cfg(feature = "std")]
+fn select_median(range: &mut [Photon], mid: usize, axis: usize) {
+    match axis {
+        0 => select_on::<0>(range, mid),
+        1 => select_on::<1>(range, mid),
+        _ => select_on::<2>(range, mid),
+    }
+}
+
+#[cfg(feature = "std")]
+#[inline(never)]
+fn select_on<const A: usize>(range: &mut [Photon], mid: usize) {
+    range.select_nth_unstable_by(mid, |a, b| a.coord(A).total_cmp(&b.coord(A)));
+}
+
+#[cfg(not(feature = "std"))]
+fn select_median(range: &mut [Photon], mid: usize, axis: usize) {
+    range.select_nth_unstable_by(mid, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
+}
+
+/// Partitions `start` and every subtree below it. `photons` holds the positions
+/// `base..base + photons.len()` of the whole array.
+fn partition(photons: &mut [Photon], base: usize, start: Subtree) {
     // The ranges still to split. Right first, so that the left one is split next: the
     // stack then holds at most one pending right range per level.
     let mut stack = [start; usize::BITS as usize + 1];
@@ -113,16 +164,7 @@ fn partition(
         if t.hi - t.lo <= BUCKET {
             continue; // a leaf
         }
-        if t.depth >= stop {
-            pending(t);
-            continue;
-        }
-        let range = &mut photons[t.lo - base..t.hi - base];
-        let mid = range.len() / 2;
-        let axis = longest_axis(range);
-        range.select_nth_unstable_by(mid, |a, b| a.coord(axis).total_cmp(&b.coord(axis)));
-        range[mid].set_axis(axis);
-        let m = t.lo + mid;
+        let m = t.lo + split(&mut photons[t.lo - base..t.hi - base]);
         let depth = t.depth + 1;
         stack[sp] = Subtree {
             lo: m + 1,
@@ -559,12 +601,20 @@ mod tests {
             balance(&mut whole);
             for levels in [0u32, 1, 3, 20] {
                 let mut parts = base.clone();
-                let mut pending = Vec::new();
-                balance_top(&mut parts, levels, |t| pending.push(t));
-                // Balance the subtrees in reverse order: the order must not matter.
-                for t in pending.iter().rev() {
-                    assert!(t.hi - t.lo > BUCKET && t.depth == levels);
-                    balance_subtree(&mut parts[t.lo..t.hi], *t);
+                // Split the top `levels` levels, then balance the subtrees below them
+                // right to left: the order must not matter.
+                let mut pending = std::vec![(&mut parts[..], Subtree::root(n))];
+                let mut bottom = Vec::new();
+                while let Some((slice, t)) = pending.pop() {
+                    if t.depth == levels {
+                        bottom.push((slice, t));
+                    } else if let Some(children) = split_subtree(slice, t) {
+                        pending.extend(children);
+                    }
+                }
+                for (slice, t) in bottom {
+                    assert_eq!((slice.len(), t.depth), (t.hi - t.lo, levels));
+                    balance_subtree(slice, t);
                 }
                 assert_eq!(parts, whole, "n={n} levels={levels}");
             }

@@ -26,7 +26,9 @@ pub use illumination::{
 };
 #[cfg(feature = "std")]
 pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
-pub use kdtree::{balance, balance_subtree, balance_top, Found, KdTree, Neighbor, Subtree, BUCKET};
+pub use kdtree::{
+    balance, balance_subtree, split_subtree, Found, KdTree, Neighbor, Subtree, BUCKET,
+};
 pub use packed::Photon;
 pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
 
