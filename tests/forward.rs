@@ -286,6 +286,10 @@ fn the_parallel_forward_pass_is_the_serial_one() {
     let s = PhotonSettings::new(60_000, 16, 0.1, 8).unwrap();
     let (serial, unit, _) = photons(&scene, &s, 9);
     assert!(serial.len() > 1 << 15, "{}", serial.len());
+    let mut splats = Vec::new();
+    let mut buf = vec![Photon::ZERO; photon::photons_needed(&scene, &s)];
+    photon::shoot_with_splats(&scene, &s, 9, 0, &mut buf, &mut splats).unwrap();
+    assert!(splats.len() > 1000, "{}", splats.len());
     for threads in [1, 3] {
         let mut buf = PhotonBuffer::for_budget(&scene, &s).unwrap();
         buf.fill(
@@ -300,5 +304,10 @@ fn the_parallel_forward_pass_is_the_serial_one() {
         .unwrap();
         assert_eq!(buf.unit(), unit);
         assert_eq!(buf.tree().photons(), &serial[..], "{threads} threads");
+        assert_eq!(
+            buf.splats(),
+            &splats[..],
+            "{threads} threads: splats in order"
+        );
     }
 }

@@ -23,7 +23,6 @@ use crate::Error;
 #[derive(Debug)]
 pub struct PhotonBuffer {
     photons: vec::Vec<Photon>,
-    len: usize,
     unit: f32,
     splats: vec::Vec<Splat>,
     /// The coarse levels of the store (see [`KdStore::with_coarse_levels`]), balanced.
@@ -140,6 +139,31 @@ impl<'a> Pool<'a> {
     }
 }
 
+/// The forward pass's chunks, appended to the buffer in emission order as they finish.
+struct InOrder<'a> {
+    /// The first chunk not yet appended.
+    next: usize,
+    /// Finished chunks waiting for an earlier one: photons and splats.
+    done: vec::Vec<Option<Chunk>>,
+    photons: &'a mut vec::Vec<Photon>,
+    splats: &'a mut vec::Vec<Splat>,
+}
+
+/// One chunk's photons and splats.
+type Chunk = (vec::Vec<Photon>, vec::Vec<Splat>);
+
+impl InOrder<'_> {
+    /// Chunk `k` is traced: appends it and every finished chunk after it that is due.
+    fn finish(&mut self, k: usize, chunk: Chunk) {
+        self.done[k] = Some(chunk);
+        while let Some((photons, splats)) = self.done.get_mut(self.next).and_then(Option::take) {
+            self.photons.extend_from_slice(&photons);
+            self.splats.extend_from_slice(&splats);
+            self.next += 1;
+        }
+    }
+}
+
 /// Photons traced per work item of the parallel forward pass. Fixed, so that the order
 /// of the stored photons — and so the tree and the image — does not depend on the
 /// number of threads.
@@ -153,9 +177,9 @@ impl PhotonBuffer {
         settings: &PhotonSettings,
     ) -> Result<Self, Error> {
         let needed = desktop_budget(scene, settings)?;
+        // Reserved, not written: a page is first touched by the pass that fills it.
         Ok(Self {
-            photons: vec![Photon::ZERO; needed],
-            len: 0,
+            photons: vec::Vec::with_capacity(needed),
             unit: 0.0,
             splats: vec::Vec::new(),
             coarse: [vec::Vec::new(), vec::Vec::new()],
@@ -179,7 +203,7 @@ impl PhotonBuffer {
         progress: &Progress,
     ) -> Result<(), Error> {
         let needed = photons_needed(scene, settings);
-        within(needed, self.photons.len(), "photons (count × lights)")?;
+        within(needed, self.photons.capacity(), "photons (count × lights)")?;
         let t = Instant::now();
         let emitter = Emitter::new(scene, settings, seed, pass);
         let items: vec::Vec<(usize, u32, u32)> = (0..scene.lights().len())
@@ -191,16 +215,17 @@ impl PhotonBuffer {
             })
             .collect();
         progress.phase(pass, "photons", items.len());
-        // Chunk k's photons land in its own stretch of the array — emission index
-        // `first(l) + start..`, at most one photon per emitted one — and are moved down
-        // into emission order after: no second buffer. Its splats go to its own list.
-        let mut rest = &mut self.photons[..needed];
-        let mut slots = vec::Vec::with_capacity(items.len());
-        for &(_, start, end) in &items {
-            let (slot, tail) = rest.split_at_mut((end - start) as usize);
-            slots.push(Mutex::new((slot, 0usize, vec::Vec::new())));
-            rest = tail;
-        }
+        // Each chunk is traced into its own lists; the finished ones are appended to
+        // the buffer in emission order by whichever thread finishes the next one due,
+        // while the others trace on.
+        self.photons.clear();
+        self.splats.clear();
+        let order = Mutex::new(InOrder {
+            next: 0,
+            done: (0..items.len()).map(|_| None).collect(),
+            photons: &mut self.photons,
+            splats: &mut self.splats,
+        });
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
             for _ in 0..threads.clamp(1, items.len().max(1)) {
@@ -209,33 +234,19 @@ impl PhotonBuffer {
                     let Some(&(l, start, end)) = items.get(k) else {
                         break;
                     };
-                    if let Ok(mut chunk) = slots[k].lock() {
-                        let (slot, len, splats) = &mut *chunk;
-                        for x in (start..end).filter_map(|i| emitter.land(l, i)) {
-                            slot[*len] = x.photon;
-                            *len += 1;
-                            splats.extend(x.splat);
-                        }
+                    let mut chunk = (vec::Vec::with_capacity(CHUNK as usize), vec::Vec::new());
+                    for x in (start..end).filter_map(|i| emitter.land(l, i)) {
+                        chunk.0.push(x.photon);
+                        chunk.1.extend(x.splat);
+                    }
+                    if let Ok(mut order) = order.lock() {
+                        order.finish(k, chunk);
                     }
                     progress.tick();
                 });
             }
         });
-        let counts: vec::Vec<(usize, vec::Vec<Splat>)> = slots
-            .into_iter()
-            .map(|m| {
-                let (_, len, splats) = m.into_inner().unwrap_or_default();
-                (len, splats)
-            })
-            .collect();
-        let (mut stored, mut at) = (0, 0);
-        self.splats.clear();
-        for (&(_, start, end), (len, splats)) in items.iter().zip(counts) {
-            self.photons.copy_within(at..at + len, stored);
-            stored += len;
-            at += (end - start) as usize;
-            self.splats.extend_from_slice(&splats);
-        }
+        let stored = self.photons.len();
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
         // Every THINNING-th photon in emission order: a selection that does not depend
@@ -251,19 +262,18 @@ impl PhotonBuffer {
         };
         let level2 = thin(&level1);
         self.coarse = [level1, level2];
-        let (photons, coarse) = (&mut self.photons[..stored], &mut self.coarse);
+        let (photons, coarse) = (&mut self.photons[..], &mut self.coarse);
         balance_parallel(photons, coarse, threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
         stats.photons_stored += stored as u64;
-        self.len = stored;
         self.unit = emitter.power_unit();
         Ok(())
     }
 
     /// The balanced tree of the last pass.
     pub fn tree(&self) -> KdTree<'_> {
-        KdTree::from_balanced(&self.photons[..self.len])
+        KdTree::from_balanced(&self.photons)
     }
 
     /// The caustic store over the last pass's tree and its coarse levels, gathering up
