@@ -230,6 +230,7 @@ impl RenderArgs {
             error_map: self.error_map.clone(),
             target_error: self.target_error,
             time_limit: self.time_limit,
+            time_gathers: self.stats,
         }
     }
 }
