@@ -16,7 +16,7 @@ use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
 use caustic::photon;
 use caustic::photon::{NoCaustics, PhotonSettings};
-use caustic::render::PixelEstimate;
+use caustic::render::{PixelEstimate, Sampling, REFINE};
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
 use support::{add_floor, add_glass_sphere, add_light, scene_text};
@@ -354,6 +354,41 @@ fn images_are_bit_identical_whatever_the_thread_count() {
         .unwrap();
         assert_ne!(bits(&a), bits(&c), "{name}");
     }
+}
+
+/// Rows rendered in order with one shared line of corners are the rows rendered alone,
+/// bit for bit, for two thirds of the corner rays; a line left by another row (here
+/// the row below) is not taken for this row's top corners.
+#[test]
+fn rows_sharing_their_corners_are_the_rows() {
+    let (scene, settings) = small("two_balls.json", 40, 30);
+    let mut buf = PhotonBuffer::for_budget(&scene, &settings).unwrap();
+    let mut stats = caustic::desktop::RenderStats::default();
+    buf.fill(&scene, &settings, 1, 0, 2, &mut stats, &Progress::hidden())
+        .unwrap();
+    let store = buf.store::<64>(&settings).unwrap();
+    let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+        Renderer::new(&scene, &store, settings.max_depth())
+            .unwrap()
+            .with_sampling(Sampling::Adaptive(REFINE))
+            .unwrap()
+            .with_splats(buf.splats());
+    let (w, h) = (40usize, 30u32);
+    let (mut alone, mut shared) = (RayCount::default(), RayCount::default());
+    let mut samples = vec![caustic::render::Sample::default(); w + 1];
+    let mut line = caustic::render::CornerLine::new(&mut samples);
+    for y in [5, 4].into_iter().chain(0..h) {
+        let (mut a, mut b) = (
+            vec![PixelEstimate::default(); w],
+            vec![PixelEstimate::default(); w],
+        );
+        alone += r.row(y, &mut a);
+        shared += r.row_sharing(y, &mut b, &mut line);
+        assert_eq!(a, b, "row {y}");
+    }
+    // Each of the 30 rows in order after the first saves its 41 top corners (at least
+    // one eye ray each); rows 5 and 4 save nothing (row 5 left line 6, not line 4's).
+    assert!(alone.eye - shared.eye >= 29 * 41, "{shared:?} {alone:?}");
 }
 
 /// Progressive passes too: the same seed gives the same bits on any number of threads.

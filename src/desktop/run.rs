@@ -22,7 +22,9 @@ use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::photon::{
     self, add_to_frame, CausticStore, Footprint, Halves, Photon, PhotonSettings, Splat,
 };
-use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
+use crate::render::{
+    CornerLine, ErrorTally, PixelEstimate, RayCount, Renderer, Sample, Sampling, REFINE,
+};
 use crate::Error;
 
 /// How to render on the desktop.
@@ -443,8 +445,10 @@ fn backward_pass<S: CausticStore + Sync>(
     Ok(frame)
 }
 
-/// Renders all rows of `frame` (`width` pixels each) on `threads` threads, each taking
-/// the next free row.
+/// Renders all rows of `frame` (`width` pixels each) on `threads` threads. Each takes
+/// the next free band of consecutive rows — eight, shrinking to one at the end so that
+/// the threads finish together — and renders it top to bottom, a row's bottom corners
+/// serving as the next row's top ones ([`Renderer::row_sharing`]).
 pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const D: usize>(
     renderer: &Renderer<'_, S, O, L, D>,
     frame: &mut [PixelEstimate],
@@ -458,11 +462,28 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
         for _ in 0..threads {
             s.spawn(|| {
                 let mut mine = RayCount::default();
+                let mut samples = vec![Sample::default(); width + 1];
                 loop {
-                    let next = rows.lock().map(|mut r| r.next()).unwrap_or(None);
-                    let Some((y, row)) = next else { break };
-                    mine += renderer.row(y as u32, row);
-                    progress.tick();
+                    let band: vec::Vec<_> = match rows.lock() {
+                        Ok(mut r) => {
+                            // Eight rows, fewer in the last 128: the bands depend
+                            // on the image alone, so the rays traced do not depend
+                            // on the thread count (nor does the image, ever).
+                            let take = (r.len() / 16).clamp(1, 8);
+                            r.by_ref().take(take).collect()
+                        }
+                        Err(_) => break,
+                    };
+                    if band.is_empty() {
+                        break;
+                    }
+                    // A fresh line for each band: its first row traces its top
+                    // corners whichever band came before on this thread.
+                    let mut line = CornerLine::new(&mut samples);
+                    for (y, row) in band {
+                        mine += renderer.row_sharing(y as u32, row, &mut line);
+                        progress.tick();
+                    }
                 }
                 if let Ok(mut t) = total.lock() {
                     *t += mine;

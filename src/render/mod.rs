@@ -76,7 +76,7 @@ mod estimate;
 mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
-pub use pixels::{RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
+pub use pixels::{CornerLine, RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -193,6 +193,13 @@ pub struct Sample {
     pub split: Rgb,
     /// FNV-1a hash of the path's events.
     pub signature: u32,
+}
+
+/// The empty sample (no radiance), for initialising buffers of samples.
+impl Default for Sample {
+    fn default() -> Self {
+        Self::START
+    }
 }
 
 impl Sample {

@@ -151,25 +151,23 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         self.sample(self.scene.camera().ray_at(cx, cy, 0.0, 0.0), count)
     }
 
-    /// Renders row `y` (0 = top) pixel by pixel, handing each estimate to `put`.
+    /// Renders row `y` (0 = top) pixel by pixel, handing each estimate to `put`. With
+    /// a `line` of at least `width + 1` samples, the adaptive sampling takes the row's
+    /// top corners from it when it holds them and leaves the bottom ones in it.
     fn row_with(
         &self,
         y: u32,
         width: usize,
+        line: Option<&mut CornerLine<'_>>,
         mut put: impl FnMut(usize, PixelEstimate),
     ) -> RayCount {
         let mut count = RayCount::default();
         let camera = self.scene.camera();
-        let one = |s: Sample| PixelEstimate {
-            radiance: s.radiance,
-            caustic: s.caustic,
-            split: s.split,
-            ..PixelEstimate::default()
-        };
         match self.sampling {
             Sampling::Centre => {
                 for x in 0..width {
-                    put(x, one(self.sample(camera.ray(x as u32, y), &mut count)));
+                    let s = self.sample(camera.ray(x as u32, y), &mut count);
+                    put(x, one(&s));
                 }
             }
             Sampling::Grid(n) => {
@@ -178,37 +176,59 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
             }
             Sampling::Adaptive(n) => {
+                let mut line = line.filter(|l| l.samples.len() > width);
+                let shared = line.as_ref().is_some_and(|l| l.line == Some(y));
+                // The top corner `x` when the line holds row y's.
+                let held = |line: &Option<&mut CornerLine<'_>>, x: usize| {
+                    line.as_ref().filter(|_| shared).map(|l| l.samples[x])
+                };
                 // Corners shared along the row: the left pair comes from the pixel before.
-                let mut top = self.corner(0, y, &mut count);
-                let mut bottom = self.corner(0, y + 1, &mut count);
+                let mut top_left = held(&line, 0).unwrap_or_else(|| self.corner(0, y, &mut count));
+                let mut bottom_left = self.corner(0, y + 1, &mut count);
                 for x in 0..width {
-                    let right_top = self.corner(x as u32 + 1, y, &mut count);
-                    let right_bottom = self.corner(x as u32 + 1, y + 1, &mut count);
-                    let c = [top, right_top, bottom, right_bottom];
-                    put(
-                        x,
-                        if agree(&c) {
-                            let mean = |f: fn(&Sample) -> Rgb| {
-                                (f(&c[0]) + f(&c[1]) + f(&c[2]) + f(&c[3])) * 0.25
-                            };
-                            PixelEstimate {
-                                radiance: mean(|s| s.radiance),
-                                caustic: mean(|s| s.caustic),
-                                split: mean(|s| s.split),
-                                ..PixelEstimate::default()
-                            }
-                        } else {
-                            count.refined += 1;
-                            let bright =
-                                c.iter().map(|s| s.radiance.luminance()).fold(0.0, f32::max);
-                            self.refine(x as u32, y, n, bright, &mut count)
-                        },
-                    );
-                    (top, bottom) = (right_top, right_bottom);
+                    let top_right = held(&line, x + 1)
+                        .unwrap_or_else(|| self.corner(x as u32 + 1, y, &mut count));
+                    let bottom_right = self.corner(x as u32 + 1, y + 1, &mut count);
+                    let c = [top_left, top_right, bottom_left, bottom_right];
+                    put(x, self.adaptive(x as u32, y, n, &c, &mut count));
+                    if let Some(l) = line.as_mut() {
+                        // Slot x's top corner has been read: it takes the bottom one.
+                        l.samples[x] = bottom_left;
+                    }
+                    (top_left, bottom_left) = (top_right, bottom_right);
+                }
+                if let Some(l) = line {
+                    l.samples[width] = bottom_left;
+                    l.line = Some(y + 1);
                 }
             }
         }
         count
+    }
+
+    /// Pixel `(x, y)` from its four corner samples `c` (top left, top right, bottom
+    /// left, bottom right): their mean where they agree, else an `n × n` grid refined.
+    fn adaptive(
+        &self,
+        x: u32,
+        y: u32,
+        n: u32,
+        c: &[Sample; 4],
+        count: &mut RayCount,
+    ) -> PixelEstimate {
+        if agree(c) {
+            let mean = |f: fn(&Sample) -> Rgb| (f(&c[0]) + f(&c[1]) + f(&c[2]) + f(&c[3])) * 0.25;
+            PixelEstimate {
+                radiance: mean(|s| s.radiance),
+                caustic: mean(|s| s.caustic),
+                split: mean(|s| s.split),
+                ..PixelEstimate::default()
+            }
+        } else {
+            count.refined += 1;
+            let bright = c.iter().map(|s| s.radiance.luminance()).fold(0.0, f32::max);
+            self.refine(x, y, n, bright, count)
+        }
     }
 
     /// Renders row `y` (0 = top) into `row` (`row.len()` = image width): radiance
@@ -216,7 +236,22 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// ([`PixelEstimate`]), the same radiance bit for bit. Without the splats (see
     /// [`with_splats`](Self::with_splats)).
     pub fn row<T: RowPixel>(&self, y: u32, row: &mut [T]) -> RayCount {
-        self.row_with(y, row.len(), |x, p| row[x] = T::from_estimate(p))
+        self.row_with(y, row.len(), None, |x, p| row[x] = T::from_estimate(p))
+    }
+
+    /// [`row`](Self::row), keeping the corner samples the adaptive sampling shares
+    /// between consecutive rows in `line`: rows rendered in order with one line trace
+    /// each line of corners once instead of twice. The same pixels, bit for bit (a
+    /// corner's sample depends on nothing but its position), and fewer rays.
+    pub fn row_sharing<T: RowPixel>(
+        &self,
+        y: u32,
+        row: &mut [T],
+        line: &mut CornerLine<'_>,
+    ) -> RayCount {
+        self.row_with(y, row.len(), Some(line), |x, p| {
+            row[x] = T::from_estimate(p)
+        })
     }
 
     /// The row buffer cut to the image width; an error when it is shorter.
@@ -254,6 +289,36 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             sink(y, row).map_err(RowsError::Sink)?;
         }
         Ok(count)
+    }
+}
+
+/// The samples at one line of pixel corners, which the adaptive sampling of the row
+/// above and of the row below both need: see [`Renderer::row_sharing`].
+#[derive(Debug)]
+pub struct CornerLine<'a> {
+    /// The line of corners `samples` holds (`y` = the top corners of row `y`).
+    line: Option<u32>,
+    samples: &'a mut [Sample],
+}
+
+impl<'a> CornerLine<'a> {
+    /// An empty line over `samples`, which must hold at least the image width plus
+    /// one (a shorter one is not used).
+    pub fn new(samples: &'a mut [Sample]) -> Self {
+        Self {
+            line: None,
+            samples,
+        }
+    }
+}
+
+/// A pixel of one sample.
+fn one(s: &Sample) -> PixelEstimate {
+    PixelEstimate {
+        radiance: s.radiance,
+        caustic: s.caustic,
+        split: s.split,
+        ..PixelEstimate::default()
     }
 }
 
