@@ -76,7 +76,10 @@ mod estimate;
 mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
-pub use pixels::{CornerLine, RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE};
+pub use pixels::{
+    CornerLine, RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE,
+    SIGNATURE_WEIGHT,
+};
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
 ///
@@ -191,7 +194,10 @@ pub struct Sample {
     /// That part's estimate from the forward pass's half 0 minus half 1's
     /// ([`Halves`]): its noise.
     pub split: Rgb,
-    /// FNV-1a hash of the path's events.
+    /// FNV-1a hash of the path's events: the objects its branches meet and the
+    /// lights visible where they shade, for the branches weighing at least
+    /// [`SIGNATURE_WEIGHT`]. Made only under [`Sampling::Adaptive`], whose corners
+    /// compare it; otherwise the hash of no events.
     pub signature: u32,
 }
 
@@ -324,6 +330,15 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         self.scene
     }
 
+    /// `true` when what branch `b` meets goes into its sample's signature: under the
+    /// adaptive sampling (the only reader of signatures), when a channel of its
+    /// weight is at least [`SIGNATURE_WEIGHT`] (the first usually is: one test).
+    #[inline]
+    fn significant(&self, b: &Branch) -> bool {
+        let (w, t) = (b.weight, SIGNATURE_WEIGHT);
+        matches!(self.sampling, Sampling::Adaptive(_)) && (w.r >= t || w.g >= t || w.b >= t)
+    }
+
     /// Radiance arriving at the origin of `ray` along it, spending at most the ray
     /// budget (see the [module documentation](self)).
     pub fn radiance(&self, ray: Ray, count: &mut RayCount) -> Rgb {
@@ -354,7 +369,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             count.eye += 1;
             if let Some((hit, index)) = self.scene.intersect(&b.ray, f32::INFINITY) {
-                out.mix(index as u32 | b.depth << 16);
+                if self.significant(&b) {
+                    out.mix(index as u32 | b.depth << 16);
+                }
                 let (local, [first, second]) =
                     self.scatter(&b, &hit, index, &mut trail, count, &mut out);
                 out.radiance += local;
@@ -379,7 +396,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     continue;
                 }
             } else {
-                out.mix(u32::MAX);
+                if self.significant(&b) {
+                    out.mix(u32::MAX);
+                }
                 out.radiance += b.weight * self.scene.background();
             }
             match stack.pop() {
@@ -534,7 +553,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut e = caustic.total;
         for light in self.scene.lights() {
             let lit = self.direct_one(hit, light, count);
-            log.mix(lit.is_some() as u32);
+            if self.significant(b) {
+                log.mix(lit.is_some() as u32);
+            }
             if let Some((l, irradiance)) = lit {
                 e += irradiance * hit.normal.dot(l.get());
             }
@@ -560,7 +581,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut lit = Rgb::ZERO;
         for light in self.scene.lights() {
             let seen = self.direct_one(hit, light, count);
-            log.mix(seen.is_some() as u32);
+            if self.significant(b) {
+                log.mix(seen.is_some() as u32);
+            }
             if let Some((l, e)) = seen {
                 lit += c.kernel(n, l, to_eye) * e;
             }
