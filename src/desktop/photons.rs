@@ -42,7 +42,7 @@ pub(super) fn desktop_budget<const O: usize, const L: usize>(
 /// Balances the kd-tree and its coarse levels on `threads` threads, the same arrays
 /// as [`balance`] makes, bit for bit. A pool of jobs: the root is split on one thread
 /// while another balances the coarse levels; each split hands out its two children,
-/// down to the fourth level of subtrees per thread, which are balanced whole.
+/// down to the first level with four subtrees per thread, which are balanced whole.
 fn balance_parallel(
     photons: &mut [Photon],
     coarse: &mut [vec::Vec<Photon>],
