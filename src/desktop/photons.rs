@@ -246,7 +246,6 @@ impl PhotonBuffer {
                 });
             }
         });
-        let stored = self.photons.len();
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
         // Every THINNING-th photon in emission order: a selection that does not depend
@@ -256,7 +255,7 @@ impl PhotonBuffer {
             from.iter().step_by(THINNING).copied().collect()
         };
         let level1 = if settings.camera_splats() {
-            thin(&self.photons[..stored])
+            thin(&self.photons)
         } else {
             vec::Vec::new()
         };
@@ -266,7 +265,7 @@ impl PhotonBuffer {
         balance_parallel(photons, coarse, threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());
         stats.photons_emitted += emitter.emitted();
-        stats.photons_stored += stored as u64;
+        stats.photons_stored += self.photons.len() as u64;
         self.unit = emitter.power_unit();
         Ok(())
     }

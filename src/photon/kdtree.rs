@@ -73,6 +73,24 @@ impl Subtree {
             depth: 0,
         }
     }
+
+    /// The two children of this subtree split at position `m` (of the whole array):
+    /// `lo..m` and `m + 1..hi`, one level deeper.
+    fn children(&self, m: usize) -> [Subtree; 2] {
+        let depth = self.depth + 1;
+        [
+            Subtree {
+                lo: self.lo,
+                hi: m,
+                depth,
+            },
+            Subtree {
+                lo: m + 1,
+                hi: self.hi,
+                depth,
+            },
+        ]
+    }
 }
 
 /// One step of [`balance`], for a caller that has threads (the core has none): splits
@@ -88,25 +106,8 @@ pub fn split_subtree(photons: &mut [Photon], t: Subtree) -> Option<[(&mut [Photo
     }
     let mid = split(photons);
     let (left, right) = photons.split_at_mut(mid);
-    let (m, depth) = (t.lo + mid, t.depth + 1);
-    Some([
-        (
-            left,
-            Subtree {
-                lo: t.lo,
-                hi: m,
-                depth,
-            },
-        ),
-        (
-            &mut right[1..],
-            Subtree {
-                lo: m + 1,
-                hi: t.hi,
-                depth,
-            },
-        ),
-    ])
+    let [l, r] = t.children(t.lo + mid);
+    Some([(left, l), (&mut right[1..], r)])
 }
 
 /// Balances subtree `t`; `photons` is the whole array's slice `t.lo..t.hi`.
@@ -165,17 +166,8 @@ fn partition(photons: &mut [Photon], base: usize, start: Subtree) {
             continue; // a leaf
         }
         let m = t.lo + split(&mut photons[t.lo - base..t.hi - base]);
-        let depth = t.depth + 1;
-        stack[sp] = Subtree {
-            lo: m + 1,
-            hi: t.hi,
-            depth,
-        };
-        stack[sp + 1] = Subtree {
-            lo: t.lo,
-            hi: m,
-            depth,
-        };
+        let [left, right] = t.children(m);
+        (stack[sp], stack[sp + 1]) = (right, left);
         sp += 2;
     }
 }
