@@ -73,7 +73,7 @@ impl DeviceBudget {
 }
 
 /// The paper's Fig. 6 (`demo::fig6`, two objects and one light) on a device:
-/// 160 × 120, 2 048 photons emitted of which 527 are stored (capacity 576, 9 KiB) and
+/// 160 × 120, 2 048 photons emitted of which 533 are stored (capacity 576, 9 KiB) and
 /// as many seen by the eye (splats, capacity 576), `K` = 32 within radius 1 (the cube's
 /// edge is 4), 8 specular interactions, seed 0.
 pub const FIG6: DeviceBudget = DeviceBudget {

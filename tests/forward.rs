@@ -237,19 +237,24 @@ fn projection_maps_match_full_sphere_emission_for_a_fraction_of_the_work() {
             .sqrt()
     };
     assert!(mean(&a) > 0.0);
-    let noise = rmse(&a, &b);
+    // Two unbiased estimates differ by √(σ_a² + σ_c²); two seeds of one by √2·σ. The
+    // full sphere's photons are the noisier (0.020 against 0.008 per pixel here): its
+    // point set spends most of its strata on directions that miss.
+    let (d, _) = caustic_image(&scene, &full, 2);
+    let (noise_maps, noise_full) = (rmse(&a, &b), rmse(&c, &d));
+    let noise = ((noise_maps.powi(2) + noise_full.powi(2)) / 2.0).sqrt();
     let diff = rmse(&a, &c);
-    eprintln!("projection maps: rmse vs full sphere {diff:.5}, seed noise {noise:.5}, photons {emitted_a} vs {emitted_c}");
+    eprintln!("projection maps: rmse vs full sphere {diff:.5}, seed noise {noise_maps:.5} (maps) {noise_full:.5} (full sphere), photons {emitted_a} vs {emitted_c}");
     assert!(
         diff < 1.5 * noise,
-        "maps vs full sphere {diff:.4} exceeds the seed-to-seed noise {noise:.4}"
+        "maps vs full sphere {diff:.4} exceeds their seed-to-seed noise {noise:.4}"
     );
-    // Total caustic light agrees within 2%.
+    // Total caustic light agrees within 2%, each the mean of its two seeds (the full
+    // sphere's two totals differ by 3.6%).
+    let (maps_total, full_total) = (mean(&a) + mean(&b), mean(&c) + mean(&d));
     assert!(
-        (mean(&a) - mean(&c)).abs() / mean(&c) < 0.02,
-        "{} vs {}",
-        mean(&a),
-        mean(&c)
+        (maps_total - full_total).abs() / full_total < 0.02,
+        "{maps_total} vs {full_total}"
     );
 }
 

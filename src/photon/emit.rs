@@ -161,7 +161,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         light: &PointLight,
         index: u32,
         shift: (f32, f32),
-    ) -> (UnitVec3, Rgb) {
+    ) -> (UnitVec3, Rgb, u32) {
         match self {
             Emission::Sphere { count } => {
                 let (s, t) = hammersley(index, *count, shift);
@@ -170,7 +170,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
                 let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
                 let power = light.intensity() * (4.0 * PI / *count as f32);
-                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power)
+                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power, index)
             }
             Emission::Cones(cones) => {
                 // Find the cone this index falls into, then its local index.
@@ -197,7 +197,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                     .filter(|&(j, o)| j == which || o.contains(dir))
                     .map(|(_, o)| o.count as f32 / o.solid_angle)
                     .sum();
-                (dir, light.intensity() * (1.0 / density))
+                (dir, light.intensity() * (1.0 / density), local)
             }
         }
     }
@@ -231,7 +231,7 @@ mod tests {
         let mut bands = [0u32; 10];
         let mut total = Rgb::ZERO;
         for i in 0..40_000 {
-            let (d, p) = plan.photon(&light, i, (0.1, 0.7));
+            let (d, p, _) = plan.photon(&light, i, (0.1, 0.7));
             bands[((d.get().z + 1.0) * 5.0).min(9.0) as usize] += 1;
             total += p;
         }
@@ -255,7 +255,7 @@ mod tests {
         assert_eq!(plan.count(), 50_000);
         let mut flux = 0.0;
         for i in 0..50_000 {
-            let (d, p) = plan.photon(&light, i, (0.3, 0.6));
+            let (d, p, _) = plan.photon(&light, i, (0.3, 0.6));
             assert!(cones.iter().any(|c| c.contains(d)));
             flux += p.r;
         }

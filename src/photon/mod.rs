@@ -38,7 +38,7 @@ use crate::error::{in_range, positive, within, Error};
 use crate::geometry::Ray;
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::sampling::{hash, unit_f32, Pcg32};
+use crate::sampling::{hash, mix64, unit_f32, PathSampler};
 use crate::scene::Scene;
 
 /// The seam between the forward and the backward pass: how much caustic light arrives
@@ -303,8 +303,12 @@ pub fn photons_needed<const O: usize, const L: usize>(
 /// randomised quasi-Monte Carlo). Each half alone is an unbiased estimate; a photon
 /// carries `n_h/n` of its half's power, so the two add up to one estimate from `n`
 /// photons, and their difference measures that estimate's error (Owen 1997; see
-/// [`Splat::half`]). The random choices of photon `i` come from a PCG32 stream keyed by
-/// `hash(seed, pass, l, i)`. A scene with no mirror, glass or reflective/transparent
+/// [`Splat::half`]). The random choices of photon `i` along its path are the further
+/// coordinates of its point (`φ₃, φ₅, φ₇, φ₁₁` of its index, each rotated by its own
+/// shift; then a PCG32 stream keyed by `hash(seed, pass, l, i)`: see [`PathSampler`]),
+/// so the photons of any small patch of the light's sphere split between reflection
+/// and refraction in the right proportions, and a caustic's pixels lose the binomial
+/// noise of independent choices (randomised QMC through the whole path: Keller 1997). A scene with no mirror, glass or reflective/transparent
 /// classic object emits nothing, and so does a dark light.
 #[derive(Clone, Debug)]
 pub struct Emitter<'a, const O: usize, const L: usize> {
@@ -323,6 +327,7 @@ pub struct Emitter<'a, const O: usize, const L: usize> {
 struct Half<const O: usize> {
     plan: Emission<O>,
     shift: (f32, f32),
+    key: u64,
     share: f32,
 }
 
@@ -345,6 +350,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 Half {
                     plan: Emission::<O>::plan(scene, light, n, full_sphere),
                     shift: (unit_f32(key as u32), unit_f32((key >> 32) as u32)),
+                    key: mix64(key),
                     share: n as f32 / count.max(1) as f32,
                 }
             };
@@ -399,9 +405,13 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
     pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
         let half = &self.plans.get(l)?[(i & 1) as usize];
         let light = &self.scene.lights()[l];
-        let (dir, power) = half.plan.photon(light, i >> 1, half.shift);
+        let (dir, power, index) = half.plan.photon(light, i >> 1, half.shift);
         let power = power * half.share;
-        let mut rng = Pcg32::new(hash(&[self.seed, self.pass as u64, l as u64, i as u64]));
+        let mut rng = PathSampler::new(
+            index,
+            half.key,
+            hash(&[self.seed, self.pass as u64, l as u64, i as u64]),
+        );
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
         let landing = trace::trace(

@@ -3,7 +3,7 @@
 use crate::geometry::{Hit, Ray};
 use crate::material::{interface, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
-use crate::sampling::Pcg32;
+use crate::sampling::PathSampler;
 use crate::scene::Scene;
 
 /// Where a photon came to rest on a surface with a diffuse part.
@@ -23,7 +23,8 @@ pub(crate) struct Landing {
 ///
 /// Mirrors multiply its power by their reflectance; at a dielectric, Fresnel
 /// reflectance (1 under total internal reflection) chooses reflection or refraction by
-/// Russian roulette, so the power stays constant (Jensen 2001, §5.2); Beer absorption
+/// Russian roulette, so the power stays constant (Jensen 2001, §5.2), drawing on the
+/// photon's [`PathSampler`] (its point set's further coordinates); Beer absorption
 /// scales it along paths inside glass. A `classic` surface reflects with probability
 /// `reflectivity`, transmits with probability `transparency`, and absorbs otherwise.
 /// At most `max_depth` specular interactions; the photon is stored at the first surface
@@ -35,7 +36,7 @@ pub(crate) fn trace<const O: usize, const L: usize>(
     mut power: Rgb,
     max_depth: u32,
     store_direct: bool,
-    rng: &mut Pcg32,
+    rng: &mut PathSampler,
 ) -> Option<Landing> {
     let mut bounces = 0u32;
     loop {
