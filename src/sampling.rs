@@ -95,7 +95,7 @@ pub fn radical_inverse(mut i: u32, b: u32) -> f32 {
 /// (Fresnel's reflect-or-refract at each glass surface) are coordinates 3, 4, … of its
 /// Hammersley point, `φ₃(i), φ₅(i), …`, so photons near each other on the light's
 /// sphere also split between reflection and refraction in the right proportions.
-const PATH_BASES: [u32; 4] = [3, 5, 7, 11];
+pub const PATH_BASES: [u32; 4] = [3, 5, 7, 11];
 
 /// The random numbers of one photon's path: the next coordinates of its Hammersley
 /// point (index `i` of its set), each shifted by its own Cranley–Patterson rotation
