@@ -11,7 +11,7 @@ pub const fn mix64(mut z: u64) -> u64 {
 }
 
 /// Hashes a list of words into one 64-bit key.
-#[inline]
+#[inline(never)]
 pub fn hash(words: &[u64]) -> u64 {
     words
         .iter()
@@ -99,24 +99,28 @@ pub const PATH_BASES: [u32; 4] = [3, 5, 7, 11];
 
 /// The random numbers of one photon's path: the next coordinates of its Hammersley
 /// point (index `i` of its set), each shifted by its own Cranley–Patterson rotation
-/// derived from `key`; past [`PATH_BASES`], a PCG32 stream.
+/// derived from `key`; past [`PATH_BASES`], a PCG32 stream keyed by `hash(stream)`,
+/// made only then (most paths never get there: a photon through a ball makes two
+/// choices).
 #[derive(Clone, Debug)]
 pub struct PathSampler {
     index: u32,
     key: u64,
     dim: usize,
-    rng: Pcg32,
+    stream: [u64; 4],
+    rng: Option<Pcg32>,
 }
 
 impl PathSampler {
     /// The sampler of point `index` of the set rotated by `key`; `stream` keys the PCG32
     /// stream used past the point's dimensions.
-    pub fn new(index: u32, key: u64, stream: u64) -> Self {
+    pub fn new(index: u32, key: u64, stream: [u64; 4]) -> Self {
         Self {
             index,
             key,
             dim: 0,
-            rng: Pcg32::new(stream),
+            stream,
+            rng: None,
         }
     }
 
@@ -124,7 +128,11 @@ impl PathSampler {
     #[inline(never)]
     pub fn next_f32(&mut self) -> f32 {
         let Some(&b) = PATH_BASES.get(self.dim) else {
-            return self.rng.next_f32();
+            let stream = &self.stream;
+            return self
+                .rng
+                .get_or_insert_with(|| Pcg32::new(hash(stream)))
+                .next_f32();
         };
         let shift = unit_f32(mix64(self.key ^ self.dim as u64) as u32);
         let r = path_coordinate(self.index, self.dim, b);
@@ -234,7 +242,7 @@ mod tests {
         for i in 0..n {
             let (u, v) = hammersley(i, n, (0.13, 0.71));
             let cell = (u * 8.0) as usize * 8 + (v * 8.0) as usize;
-            let mut path = PathSampler::new(i, 0x5eed, 7);
+            let mut path = PathSampler::new(i, 0x5eed, [7; 4]);
             for dim in &mut below {
                 dim[cell] += (path.next_f32() < 0.3) as u32;
             }
@@ -246,7 +254,7 @@ mod tests {
                 .fold(0.0, f32::max);
             assert!(worst <= 6.0, "dimension {d}: {dim:?}");
         }
-        let mut random = PathSampler::new(0, 0, 7);
+        let mut random = PathSampler::new(0, 0, [7; 4]);
         random.dim = PATH_BASES.len();
         let mut cells = [0u32; 64];
         for i in 0..n {

@@ -410,7 +410,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         let mut rng = PathSampler::new(
             index,
             half.key,
-            hash(&[self.seed, self.pass as u64, l as u64, i as u64]),
+            [self.seed, self.pass as u64, l as u64, i as u64],
         );
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
