@@ -127,28 +127,28 @@ impl PathSampler {
     /// The next number in `[0, 1)`. One copy for all its callers (a device's flash).
     #[inline(never)]
     pub fn next_f32(&mut self) -> f32 {
-        let Some(&b) = PATH_BASES.get(self.dim) else {
+        if self.dim >= PATH_BASES.len() {
             let stream = &self.stream;
             return self
                 .rng
                 .get_or_insert_with(|| Pcg32::new(hash(stream)))
                 .next_f32();
-        };
+        }
         let shift = unit_f32(mix64(self.key ^ self.dim as u64) as u32);
-        let r = path_coordinate(self.index, self.dim, b);
+        let r = path_coordinate(self.index, self.dim);
         self.dim += 1;
         wrap01(r + shift)
     }
 }
 
-/// Coordinate `dim` (base `b` = `PATH_BASES[dim]`) of point `i`. With `std`, one copy
+/// Coordinate `dim` (< `PATH_BASES.len()`) of point `i`. With `std`, one copy
 /// per base, whose divisions by a constant compile to multiplications (a runtime
 /// divide costs 25–40 cycles on x86-64, one per digit); a device keeps the one loop,
 /// with its 2–12-cycle hardware divide. The same digits and the same float operations
 /// either way: the same bits.
 #[cfg(feature = "std")]
 #[inline(always)]
-fn path_coordinate(i: u32, dim: usize, _b: u32) -> f32 {
+fn path_coordinate(i: u32, dim: usize) -> f32 {
     match dim {
         0 => radical_inverse(i, PATH_BASES[0]),
         1 => radical_inverse(i, PATH_BASES[1]),
@@ -157,11 +157,11 @@ fn path_coordinate(i: u32, dim: usize, _b: u32) -> f32 {
     }
 }
 
-/// Coordinate `dim` (base `b`) of point `i`: see the `std` version.
+/// Coordinate `dim` (< `PATH_BASES.len()`) of point `i`: see the `std` version.
 #[cfg(not(feature = "std"))]
 #[inline(always)]
-fn path_coordinate(i: u32, _dim: usize, b: u32) -> f32 {
-    radical_inverse(i, b)
+fn path_coordinate(i: u32, dim: usize) -> f32 {
+    radical_inverse(i, PATH_BASES[dim % PATH_BASES.len()])
 }
 
 /// `x − floor(x)` for `x ∈ [0, 2)`, kept strictly below 1.

@@ -308,8 +308,9 @@ pub fn photons_needed<const O: usize, const L: usize>(
 /// shift; then a PCG32 stream keyed by `hash(seed, pass, l, i)`: see [`PathSampler`]),
 /// so the photons of any small patch of the light's sphere split between reflection
 /// and refraction in the right proportions, and a caustic's pixels lose the binomial
-/// noise of independent choices (randomised QMC through the whole path: Keller 1997). A scene with no mirror, glass or reflective/transparent
-/// classic object emits nothing, and so does a dark light.
+/// noise of independent choices (randomised QMC through the whole path: Keller 1997).
+/// A scene with no mirror, glass or reflective/transparent classic object emits
+/// nothing, and so does a dark light.
 #[derive(Clone, Debug)]
 pub struct Emitter<'a, const O: usize, const L: usize> {
     scene: &'a Scene<O, L>,
