@@ -162,10 +162,12 @@ fn flux_through_a_glass_slab_matches_fresnel_transmission() {
         "slab: stored {stored:.5} W, analytic {want:.5} W ({:+.3}%)",
         rel * 100.0
     );
-    // Noise: Russian roulette at ~2 interfaces over ~10⁵ photons gives σ ≈ 0.1%; light
-    // leaving through the slab's thin sides is below 0.1%.
+    // Noise: Russian roulette at ~2 interfaces over ~10⁵ photons. With independent
+    // choices (a PCG32 stream) σ ≈ 0.1% (+0.175% at this seed); drawn as further
+    // coordinates of each photon's point, the choices are stratified (+0.020%). Light
+    // leaving through the slab's thin sides is part of that.
     assert!(
-        rel.abs() < 0.005,
+        rel.abs() < 0.0006,
         "stored {stored:.5} W vs analytic {want:.5} W ({:+.3}%)",
         rel * 100.0
     );
