@@ -551,9 +551,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             Gather::Splatted | Gather::Dark => Halves::default(),
         };
         let mut e = caustic.total;
+        let logged = self.significant(b);
         for light in self.scene.lights() {
             let lit = self.direct_one(hit, light, count);
-            if self.significant(b) {
+            if logged {
                 log.mix(lit.is_some() as u32);
             }
             if let Some((l, irradiance)) = lit {
@@ -579,9 +580,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let (n, to_eye) = (hit.normal, -b.ray.dir);
         let ambient = c.color * self.scene.ambient() * c.ambient;
         let mut lit = Rgb::ZERO;
+        let logged = self.significant(b);
         for light in self.scene.lights() {
             let seen = self.direct_one(hit, light, count);
-            if self.significant(b) {
+            if logged {
                 log.mix(seen.is_some() as u32);
             }
             if let Some((l, e)) = seen {
