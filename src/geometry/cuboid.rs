@@ -113,8 +113,11 @@ impl Cuboid {
     }
 
     /// The nearest hit with `0 < t < t_max`: the slab test in the box's frame after the
-    /// bounding-sphere test.
-    #[inline]
+    /// bounding-sphere test. Always inlined on the desktop: an out-of-line call returns
+    /// its hit through memory, which the caller reads back before the stores have
+    /// retired (a stalled store-to-load forward).
+    #[cfg_attr(feature = "std", inline(always))]
+    #[cfg_attr(not(feature = "std"), inline)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         if self.surely_missed(ray, t_max) {
             return None;

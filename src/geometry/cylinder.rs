@@ -94,8 +94,10 @@ impl Cylinder {
     /// `a = dx² + dy²`, `b = ox·dx + oy·dy`, `c = ox² + oy² − r²` the roots solve
     /// `a t² + 2b t + c = 0`, with the cancellation-free discriminant
     /// `a·(r² − |o⊥ − (b/a)·d⊥|²)`. Caps are disks at `z = 0` and `z = h`. A ray that
-    /// surely misses the bounding sphere is turned away before any of this.
-    #[inline]
+    /// surely misses the bounding sphere is turned away before any of this. Always
+    /// inlined on the desktop: see [`Cuboid::intersect`](super::Cuboid::intersect).
+    #[cfg_attr(feature = "std", inline(always))]
+    #[cfg_attr(not(feature = "std"), inline)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         if surely_missed(self.center, self.reject_r2, ray, t_max) {
             return None;

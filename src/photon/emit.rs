@@ -25,7 +25,11 @@ use core::f32::consts::PI;
 
 use heapless::Vec as FixedVec;
 
+#[cfg(feature = "std")]
+use crate::geometry::BoundingSphere;
 use crate::light::PointLight;
+#[cfg(feature = "std")]
+use crate::math::max_abs;
 use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::sampling::hammersley;
 use crate::scene::Scene;
@@ -48,6 +52,26 @@ impl Cone {
     #[inline]
     fn contains(&self, d: UnitVec3) -> bool {
         self.axis.dot(d.get()) >= self.cos_max
+    }
+
+    /// `false` when no ray from `from` along a direction of this cone can meet `bound`:
+    /// the angle between the axes exceeds the sum of the half-angles, `θ` and
+    /// `asin(R/d)`. In `f64`, with the radius widened by 0.1% of the scale of the
+    /// coordinates, far beyond the rounding of the directions drawn and of the shapes'
+    /// own tests (which also widen their bounding spheres, by 10⁻⁴).
+    #[cfg(feature = "std")]
+    fn may_meet(&self, from: Vec3, bound: BoundingSphere) -> bool {
+        let v = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        let [x, y, z] = v(bound.center - from);
+        let d = libm::sqrt(x * x + y * y + z * z);
+        let r = bound.radius as f64 * 1.001 + 1e-3 * (max_abs(bound.center) + bound.radius) as f64;
+        if d <= r {
+            return true; // `from` is inside the widened bound
+        }
+        let [ax, ay, az] = v(self.axis.get());
+        let between = libm::acos(((ax * x + ay * y + az * z) / d).clamp(-1.0, 1.0));
+        let half = libm::acos(self.cos_max as f64) + 1e-3;
+        between <= half + libm::asin(r / d)
     }
 }
 
@@ -126,6 +150,37 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         Emission::Cones(cones)
     }
 
+    /// For each cone (one for the sphere), the objects of `scene` its photons may meet
+    /// on their way from `light` (bit `i`: object `i`, of the first 64): every
+    /// unbounded one, and every bounded one whose bounding sphere the cone reaches.
+    #[cfg(feature = "std")]
+    pub(crate) fn reach<const LIGHTS: usize>(
+        &self,
+        scene: &Scene<OBJECTS, LIGHTS>,
+        light: &PointLight,
+    ) -> FixedVec<u64, OBJECTS> {
+        let mut sets = FixedVec::new();
+        let cones = match self {
+            Emission::Sphere { .. } => {
+                let _ = sets.push(u64::MAX); // cannot fail: OBJECTS ≥ 1 to have a sphere
+                return sets;
+            }
+            Emission::Cones(cones) => cones,
+        };
+        for cone in cones {
+            let mut set = 0u64;
+            for (i, object) in scene.objects().iter().enumerate().take(64) {
+                let meets = object
+                    .shape
+                    .bounding_sphere()
+                    .is_none_or(|b| cone.may_meet(light.position(), b));
+                set |= (meets as u64) << i;
+            }
+            let _ = sets.push(set); // cannot fail: one set per cone
+        }
+        sets
+    }
+
     /// Photons this plan emits.
     pub(crate) fn count(&self) -> u32 {
         match self {
@@ -154,14 +209,15 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         }
     }
 
-    /// The `index`-th photon: its direction and power (W). `shift` rotates the point
-    /// set (derived from the seed and pass).
+    /// The `index`-th photon: its direction, power (W), index in its cone's point set
+    /// and cone (0 for the sphere). `shift` rotates the point set (derived from the
+    /// seed and pass).
     pub(crate) fn photon(
         &self,
         light: &PointLight,
         index: u32,
         shift: (f32, f32),
-    ) -> (UnitVec3, Rgb, u32) {
+    ) -> (UnitVec3, Rgb, u32, usize) {
         match self {
             Emission::Sphere { count } => {
                 let (s, t) = hammersley(index, *count, shift);
@@ -170,7 +226,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
                 let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
                 let power = light.intensity() * (4.0 * PI / *count as f32);
-                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power, index)
+                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power, index, 0)
             }
             Emission::Cones(cones) => {
                 // Find the cone this index falls into, then its local index.
@@ -197,7 +253,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                     .filter(|&(j, o)| j == which || o.contains(dir))
                     .map(|(_, o)| o.count as f32 / o.solid_angle)
                     .sum();
-                (dir, light.intensity() * (1.0 / density), local)
+                (dir, light.intensity() * (1.0 / density), local, which)
             }
         }
     }
@@ -231,7 +287,7 @@ mod tests {
         let mut bands = [0u32; 10];
         let mut total = Rgb::ZERO;
         for i in 0..40_000 {
-            let (d, p, _) = plan.photon(&light, i, (0.1, 0.7));
+            let (d, p, _, _) = plan.photon(&light, i, (0.1, 0.7));
             bands[((d.get().z + 1.0) * 5.0).min(9.0) as usize] += 1;
             total += p;
         }
@@ -255,7 +311,7 @@ mod tests {
         assert_eq!(plan.count(), 50_000);
         let mut flux = 0.0;
         for i in 0..50_000 {
-            let (d, p, _) = plan.photon(&light, i, (0.3, 0.6));
+            let (d, p, _, _) = plan.photon(&light, i, (0.3, 0.6));
             assert!(cones.iter().any(|c| c.contains(d)));
             flux += p.r;
         }

@@ -321,6 +321,8 @@ pub struct Emitter<'a, const O: usize, const L: usize> {
     /// `n_h/n` of the light's photons.
     plans: heapless::Vec<[Half<O>; 2], L>,
     unit: f32,
+    /// The scene's objects, for the photons' nearest-hit searches.
+    reach: trace::Reach,
 }
 
 /// One half of a light's photons.
@@ -330,6 +332,23 @@ struct Half<const O: usize> {
     shift: (f32, f32),
     key: u64,
     share: f32,
+    /// Per cone, the objects its photons' first segment is tested against.
+    #[cfg(feature = "std")]
+    reach: heapless::Vec<u64, O>,
+}
+
+impl<const O: usize> Half<O> {
+    /// The objects of `all` that the first segment of a photon of `cone` may meet.
+    #[cfg(feature = "std")]
+    fn first_reach(&self, all: trace::Reach, cone: usize) -> trace::Reach {
+        all.within(self.reach.get(cone).copied().unwrap_or(u64::MAX))
+    }
+
+    /// Every object of `all`: a device tests them all.
+    #[cfg(not(feature = "std"))]
+    fn first_reach(&self, all: trace::Reach, _: usize) -> trace::Reach {
+        all
+    }
 }
 
 impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
@@ -348,8 +367,11 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             let half = |h: u32| {
                 let n = (count + 1 - h) / 2;
                 let key = hash(&[seed, pass as u64, l as u64, h as u64]);
+                let plan = Emission::<O>::plan(scene, light, n, full_sphere);
                 Half {
-                    plan: Emission::<O>::plan(scene, light, n, full_sphere),
+                    #[cfg(feature = "std")]
+                    reach: plan.reach(scene, light),
+                    plan,
                     shift: (unit_f32(key as u32), unit_f32((key >> 32) as u32)),
                     key: mix64(key),
                     share: n as f32 / count.max(1) as f32,
@@ -375,6 +397,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             pass,
             plans,
             unit,
+            reach: trace::Reach::all(scene),
         }
     }
 
@@ -406,7 +429,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
     pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
         let half = &self.plans.get(l)?[(i & 1) as usize];
         let light = &self.scene.lights()[l];
-        let (dir, power, index) = half.plan.photon(light, i >> 1, half.shift);
+        let (dir, power, index, cone) = half.plan.photon(light, i >> 1, half.shift);
         let power = power * half.share;
         let mut rng = PathSampler::new(
             index,
@@ -422,6 +445,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             s.max_depth,
             s.store_direct,
             &mut rng,
+            self.reach,
+            half.first_reach(self.reach, cone),
         )?;
         let material = &self.scene.objects()[landing.object].material;
         let splat = if s.splat {
