@@ -219,16 +219,48 @@ pub const FOOTPRINT_VISITS: usize = 1024;
 /// tube's caustic region 0.0483 → 0.0504, in the same time.
 pub const FAINT: f32 = 1.0 / THINNING as f32;
 
-/// A footprint whose photons are fewer than this is gathered once more over the patch
-/// twice its size about the same centre (within the store's radius). Where the eye sees
-/// a surface near the focus of a ball lens its footprint is tiny and holds a photon or
-/// none, and the unbiased count-over-area is a firefly; the larger patch trades that
-/// variance for a bias confined to the pixel's neighbourhood, and only where photons
-/// are sparse, so it vanishes as the photon density grows (the shrinking radius of
-/// progressive photon mapping, Hachisuka et al. 2008, in one step). Chosen on the
-/// tube and two-balls scenes: 8 and 16 measure the same, and growing twice blurred the
-/// focus seen through the tube.
-pub const SPARSE_FOOTPRINT: u32 = 16;
+/// A footprint is sparse while one half of the forward pass holds fewer than half this
+/// many of its photons, and is then widened if the photons around it look uniform
+/// (`KdStore::widened`).
+pub const SPARSE_FOOTPRINT: u32 = 8;
+
+/// Most widenings of a sparse footprint (×4 in area each; see `KdStore::widened`).
+///
+/// Chosen with [`SPARSE_FOOTPRINT`] on the tuning scenes at 1.6M photons a light
+/// (caustic region, 4 seeds; before: one unconditional growth below 16 photons, tube
+/// 0.0445, two balls 0.0423, glass sphere 0.0354). One widening at 8: tube 0.0401, two
+/// balls 0.0388, glass sphere 0.0342; the gathers' CPU time +20% on the tube, the same
+/// on two balls. More buys the tube little for its time: two widenings 0.0385 and four
+/// at 16 photons 0.0356, but the tube's gathers 2.4× and 3.6× as long, and those of two
+/// balls 1.45× and 1.9×; one at 16 photons 0.0400, 1.6× as long on the tube.
+pub const WIDENINGS: u32 = 1;
+
+/// The tail probability below which a footprint's photon count is taken as evidence
+/// that the density is not uniform over the patch four times its area.
+pub const UNIFORM_TAIL: f32 = 0.01;
+
+/// `true` when `inner` of `total` photons in the central quarter (by area) of a patch is
+/// a plausible draw of `X ~ Bin(total, 1/4)`: `P(X ≤ inner)` and `P(X ≥ inner)` are both
+/// at least [`UNIFORM_TAIL`]. For `inner < 32` (all the widening asks), a `total`
+/// above `6·inner + 18` always fails the lower tail (checked in f64 by the tests) and
+/// is refused at once; otherwise the pmf by its recurrence `t₀ = (3/4)ⁿ`,
+/// `t_{i+1} = t_i·(n − i)/(3(i + 1))`, with `(3/4)ⁿ` a normal `f32` for `n ≤ 204`.
+fn uniform_quarter(inner: u32, total: u32) -> bool {
+    if total > 6 * inner + 18 {
+        return false;
+    }
+    // (3/4)ⁿ by repeated products: the same bits on every target.
+    let mut t = 1.0f32;
+    for _ in 0..total {
+        t *= 0.75;
+    }
+    let mut below = 0.0f32;
+    for i in 0..inner.min(total) {
+        below += t;
+        t *= (total - i) as f32 / (3 * (i + 1)) as f32;
+    }
+    below + t >= UNIFORM_TAIL && 1.0 - below >= UNIFORM_TAIL
+}
 
 impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
     /// A store over a balanced tree whose photon powers are in units of `unit` W,
@@ -305,13 +337,14 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
     /// Gathers the photons around `x` — the k nearest within the maximum radius, or with
     /// a fixed radius every photon within it — and sums `weight(photon)` over those that
     /// arrived on the front of the surface of normal `n`, with the cone filter if any.
-    /// Returns the sum (in W, including the filter's normalisation) and r².
-    #[inline]
+    /// Returns the sum (in W, including the filter's normalisation) and r². Out of
+    /// line, with the weight behind a reference: one copy for both estimates.
+    #[inline(never)]
     fn gather(
         &self,
         x: Vec3,
         n: UnitVec3,
-        mut weight: impl FnMut(UnitVec3, Rgb) -> Rgb,
+        weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> (Rgb, f32) {
         let photons = self.tree.photons();
         let filter = |r2: f32| match self.cone {
@@ -369,11 +402,11 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// Sums `weight(photon)` over the photons inside the footprint that arrived on the
     /// front of the surface of normal `n` (no cone filter: the footprint is the
-    /// kernel). Returns the sums of the two halves in W and the area they cover, or
-    /// `None` for an empty or non-finite footprint. Unbiased for the patch's average
-    /// irradiance, whatever its size or shape, except where it holds fewer than
-    /// [`SPARSE_FOOTPRINT`] photons; the work is bounded by [`FOOTPRINT_VISITS`]
-    /// photons per search.
+    /// kernel), over the area they cover: the density of the two halves, W per unit
+    /// area, or `None` for an empty or non-finite footprint. Unbiased for the patch's average
+    /// irradiance, whatever its size or shape, except where a sparse footprint is
+    /// [widened](Self::widened); the work is bounded by [`FOOTPRINT_VISITS`] photons
+    /// per search.
     #[inline(never)]
     fn gather_footprint(
         &self,
@@ -381,36 +414,23 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         n: UnitVec3,
         footprint: &Footprint,
         weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
-    ) -> Option<(Halves, f32)> {
+    ) -> Option<Halves> {
         let region = Region::new(footprint, self.max_radius2)?;
         if N <= FOOTPRINT_VISITS {
             // No search can visit more photons than the map holds: the first always
             // completes (the loop below would return the same sums). No reach test
             // either: the renderer asks `reaches` first, and a search out of reach
             // finds nothing, the same zero.
-            let (mut region, mut grown) = (region, false);
-            loop {
-                let (sum, _, found) =
-                    self.sum_in(Some(self.tree), x, n, &region, false, Some(weight));
-                match self.grown(&region, found).filter(|_| !grown) {
-                    Some(larger) => (region, grown) = (larger, true),
-                    None => {
-                        return Some((
-                            Halves::from_parts(sum[0], sum[1]).scaled(self.unit),
-                            region.area,
-                        ))
-                    }
-                }
-            }
+            return Some(self.widened(x, n, region, None, weight));
         }
         if self.out_of_reach(x) {
-            return Some((Halves::default(), region.area));
+            return Some(Halves::default());
         }
         // The finest level where the footprint visits at most FOOTPRINT_VISITS
         // photons, as the coarsest level's count predicts it: a search that would visit
         // more stops there and is tried again — a sliver cut into disks, then on the
-        // next coarser level, at last scaled down. A sparse one grows once (on level 0).
-        // A faint path's starts on level 1 (see FAINT).
+        // next coarser level, at last scaled down. A sparse one is widened (on level
+        // 0). A faint path's starts on level 1 (see FAINT).
         let levels = [Some(self.tree), self.coarse[0], self.coarse[1]];
         let faint = footprint.throughput < FAINT && self.coarse[0].is_some();
         let level = if faint {
@@ -419,19 +439,14 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
             self.first_level(x, n, &region)
         };
         let (mut region, mut level, mut cut) = (region, level, false);
-        let mut grown = false;
         loop {
             let (sum, visits, found) = self.sum_in(levels[level], x, n, &region, cut, Some(weight));
             if visits.is_some() {
-                if let Some(larger) = self.grown(&region, found).filter(|_| level == 0 && !grown) {
-                    (region, grown, cut) = (larger, true, false);
-                    continue;
+                if level == 0 {
+                    return Some(self.widened(x, n, region, Some((sum, found)), weight));
                 }
                 let scale = [1, THINNING, THINNING * THINNING][level] as f32 * self.unit;
-                return Some((
-                    Halves::from_parts(sum[0], sum[1]).scaled(scale),
-                    region.area,
-                ));
+                return Some(Halves::from_parts(sum[0], sum[1]).scaled(scale / region.area));
             }
             if !cut && region.segments().0 > 1 {
                 cut = true;
@@ -443,13 +458,79 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         }
     }
 
-    /// The region twice the size of `region` about the same centre when `found`, the
-    /// photons it held, are fewer than [`SPARSE_FOOTPRINT`] and the larger one is
-    /// within the store's radius.
-    #[inline]
-    fn grown(&self, region: &Region, found: u32) -> Option<Region> {
-        (found < SPARSE_FOOTPRINT && region.reach2 * 4.0 <= self.max_radius2)
-            .then(|| region.scaled(4.0))
+    /// The photons' density over `region` (`first`: its sums and photon counts per
+    /// half, when already searched), or over a patch about the same centre up to
+    /// [`WIDENINGS`] times ×4 larger in area, each half of the forward pass over its
+    /// own patch.
+    ///
+    /// Each half's photons are summed over the first patch where the *other* half
+    /// holds at least half of [`SPARSE_FOOTPRINT`] photons (or the last one): a patch
+    /// chosen by its own count would be biased up (it is kept when its count happens
+    /// to be high), while the halves are independent point sets, so each is summed
+    /// over a patch its own luck did not choose (cross-fitting). The patch grows while
+    /// a half is left to place and it holds fewer than twice [`SPARSE_FOOTPRINT`], if
+    /// the one twice its size lies within the store's radius and spreads its photons
+    /// as a uniform density would: the `c` of the patch among the `C` of the larger
+    /// are a plausible draw of `Bin(C, 1/4)` ([`uniform_quarter`]).
+    ///
+    /// The unbiased count-over-area of a footprint that holds a photon or none (a
+    /// faint caustic seen magnified through glass, a surface near the focus of a ball
+    /// lens) is a firefly; averaging over a wider patch trades that variance for a
+    /// bias, and only where the photons give no evidence of structure: next to a focus
+    /// or an edge the test fails and the patch stays. As the photon density grows the
+    /// footprints stop being sparse and the patch shrinks to the pixel's (the shrinking
+    /// radius of progressive photon mapping, Hachisuka et al. 2008, chosen per pixel by
+    /// a test instead of a schedule). One search site, so that a device's flash holds
+    /// one copy of the walk.
+    fn widened(
+        &self,
+        x: Vec3,
+        n: UnitVec3,
+        region: Region,
+        first: Option<([Rgb; 2], [u32; 2])>,
+        weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
+    ) -> Halves {
+        // The patch kept so far with its sums and counts; `None` before the first search.
+        let mut kept = first.map(|(sum, found)| (region, sum, found));
+        // Half h's density, once the other half has chosen its patch (`placed`).
+        let (mut density, mut placed) = ([Rgb::ZERO; 2], [false; 2]);
+        let mut next = region;
+        for _ in 0..WIDENINGS + first.is_none() as u32 {
+            if let Some((r, sum, found)) = kept {
+                for h in 0..2 {
+                    if !placed[h] && found[1 - h] >= SPARSE_FOOTPRINT / 2 {
+                        (density[h], placed[h]) = (sum[h] * (1.0 / r.area), true);
+                    }
+                }
+                // Both halves placed, or the patch holds twice the sparse count (one
+                // half's luck aside: it is not sparse), or the next is out of reach.
+                let c = found[0] + found[1];
+                if placed == [true; 2]
+                    || c >= 2 * SPARSE_FOOTPRINT
+                    || r.reach2 * 4.0 > self.max_radius2
+                {
+                    break;
+                }
+                next = r.scaled(4.0);
+            }
+            let (sum, visits, found) =
+                self.sum_in(Some(self.tree), x, n, &next, false, Some(weight));
+            match kept {
+                Some((_, _, c))
+                    if visits.is_none() || !uniform_quarter(c[0] + c[1], found[0] + found[1]) =>
+                {
+                    break
+                }
+                _ => kept = Some((next, sum, found)),
+            }
+        }
+        let (area, sum) = kept.map_or((1.0, [Rgb::ZERO; 2]), |(r, s, _)| (r.area, s));
+        for h in 0..2 {
+            if !placed[h] {
+                density[h] = sum[h] * (1.0 / area);
+            }
+        }
+        Halves::from_parts(density[0], density[1]).scaled(self.unit)
     }
 
     /// The level to try first: the finest whose photons in the region's reach are
@@ -473,10 +554,10 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
 
     /// The weighted sums of the front-side photons of `tree` inside `region`, of the
     /// forward pass's half 0 and half 1, the photons visited (`None` when they would
-    /// exceed [`FOOTPRINT_VISITS`]) and the photons summed. Without a `weight`, only
-    /// the visits are counted, and `None` once they exceed `FOOTPRINT_VISITS /
-    /// THINNING` (all [`first_level`](Self::first_level) needs; one walk serves both,
-    /// so a device's flash holds one copy of it).
+    /// exceed [`FOOTPRINT_VISITS`]) and the photons summed of each half. Without a
+    /// `weight`, only the visits are counted, and `None` once they exceed
+    /// `FOOTPRINT_VISITS / THINNING` (all [`first_level`](Self::first_level) needs;
+    /// one walk serves every search, so a device's flash holds one copy of it).
     #[inline]
     fn sum_in(
         &self,
@@ -486,7 +567,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         region: &Region,
         cut: bool,
         mut weight: Option<&mut dyn FnMut(UnitVec3, Rgb) -> Rgb>,
-    ) -> ([Rgb; 2], Option<usize>, u32) {
+    ) -> ([Rgb; 2], Option<usize>, [u32; 2]) {
         let cap = if weight.is_some() {
             FOOTPRINT_VISITS
         } else {
@@ -494,10 +575,12 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         };
         let mut sum = [Rgb::ZERO; 2];
         let Some(tree) = tree else {
-            return (sum, Some(0), 0);
+            return (sum, Some(0), [0; 2]);
         };
         let photons = tree.photons();
-        let (mut visited, mut found) = (0usize, 0u32);
+        // Photons summed, and of them half 1's (no array indexed per photon: the
+        // counts stay in registers).
+        let (mut visited, mut found, mut found1) = (0usize, 0u32, 0u32);
         let (segments, along_b) = if cut { region.segments() } else { (1, false) };
         let (long, short) = if along_b {
             (region.b, region.a)
@@ -552,15 +635,16 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                     if n.dot(dir.get()) < 0.0 {
                         sum[p.half() as usize] += weight(dir, p.power());
                         found += 1;
+                        found1 += p.half() as u32;
                     }
                 }
                 reach2
             });
             if visited > cap {
-                return (sum, None, found);
+                return (sum, None, [found - found1, found1]);
             }
         }
-        (sum, Some(visited), found)
+        (sum, Some(visited), [found - found1, found1])
     }
 }
 
@@ -587,7 +671,7 @@ impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
-        let (sum, r2) = self.gather(x, n, |_, power| power);
+        let (sum, r2) = self.gather(x, n, &mut |_, power| power);
         sum * (1.0 / (PI * r2))
     }
 
@@ -597,7 +681,7 @@ impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
         if self.out_of_reach(x) {
             return Rgb::ZERO;
         }
-        let (sum, r2) = self.gather(x, n, |dir, power| m.kernel(n, -dir, to_eye) * power);
+        let (sum, r2) = self.gather(x, n, &mut |dir, power| m.kernel(n, -dir, to_eye) * power);
         sum * (1.0 / r2)
     }
 
@@ -612,7 +696,7 @@ impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
     #[inline]
     fn irradiance_within(&self, x: Vec3, n: UnitVec3, footprint: &Footprint) -> Halves {
         match self.gather_footprint(x, n, footprint, &mut |_, power| power) {
-            Some((sum, area)) => sum.scaled(1.0 / area),
+            Some(density) => density,
             None => Halves::whole(self.irradiance(x, n)),
         }
     }
@@ -630,7 +714,7 @@ impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
     ) -> Halves {
         let mut kernel = |dir: UnitVec3, power| m.kernel(n, -dir, to_eye) * power;
         match self.gather_footprint(x, n, footprint, &mut kernel) {
-            Some((sum, area)) => sum.scaled(PI / area),
+            Some(density) => density.scaled(PI),
             None => Halves::whole(self.classic(x, n, to_eye, m)),
         }
     }
@@ -713,6 +797,144 @@ mod tests {
         );
     }
 
+    /// `uniform_quarter` is the two-sided binomial test it claims, for the counts the
+    /// widening asks about (`c < 32`, `C` up to a device map's 1024), against tails
+    /// summed in f64 from the binomial coefficients (decisions within 10⁻⁴ of the
+    /// threshold skipped: f32 rounding may fall either way there), and every count
+    /// above `6c + 18` fails it, the bound that lets a widening search stop early.
+    #[test]
+    fn the_uniformity_test_is_the_binomial_tails() {
+        let pmf = |c: u32, n: u32| -> f64 {
+            let mut binom = 1.0f64;
+            for i in 0..c {
+                binom = binom * (n - i) as f64 / (i + 1) as f64;
+            }
+            binom * 0.25f64.powi(c as i32) * 0.75f64.powi((n - c) as i32)
+        };
+        let (mut checked, mut passed) = (0, 0);
+        for n in 0..=1024u32 {
+            for c in 0..=n.min(31) {
+                let below: f64 = (0..=c).map(|i| pmf(i, n)).sum();
+                let above = 1.0 - below + pmf(c, n);
+                let want = below >= 0.01 && above >= 0.01;
+                if n > 6 * c + 18 {
+                    assert!(!want && !uniform_quarter(c, n), "{c} of {n} passes");
+                }
+                if (below - 0.01).abs() < 1e-4 || (above - 0.01).abs() < 1e-4 {
+                    continue;
+                }
+                assert_eq!(uniform_quarter(c, n), want, "{c} of {n}");
+                checked += 1;
+                passed += want as u32;
+            }
+        }
+        assert!(checked > 30_000 && passed > 300, "{checked} {passed}");
+    }
+
+    /// Photons over `[−2, 2]²` of the plane y = 0 at `density` per unit area, plus a
+    /// disk of radius 0.05 about `(0.3, 0, 0)` 400 times as dense (a focus), each of
+    /// power 1, in a store of radius 1.
+    fn field(density: f32) -> Vec<Photon> {
+        let mut g = Pcg32::new(9);
+        let mut points: Vec<Vec3> = (0..(density * 16.0) as usize)
+            .map(|_| Vec3::new(g.next_f32() * 4.0 - 2.0, 0.0, g.next_f32() * 4.0 - 2.0))
+            .collect();
+        let focus = density * 400.0 * core::f32::consts::PI * 0.05 * 0.05;
+        for _ in 0..focus as usize {
+            let (r, a) = (
+                0.05 * libm::sqrtf(g.next_f32()),
+                g.next_f32() * core::f32::consts::TAU,
+            );
+            points.push(Vec3::new(0.3 + r * libm::cosf(a), 0.0, r * libm::sinf(a)));
+        }
+        let mut photons: Vec<Photon> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| Photon::new(p, -UnitVec3::Y, Rgb::splat(1.0)).with_half(i % 2 == 0))
+            .collect();
+        balance(&mut photons);
+        photons
+    }
+
+    /// A square footprint of half-side `h` about `x` on the plane y = 0.
+    fn square(h: f32) -> Footprint {
+        Footprint {
+            a: Vec3::new(h, 0.0, 0.0),
+            b: Vec3::new(0.0, 0.0, h),
+            throughput: 1.0,
+        }
+    }
+
+    /// Over a uniform density, footprints that hold one to four photons are widened:
+    /// their estimates average to the density (no bias: each half is summed over a
+    /// patch the other half chose) with a spread well below the unwidened
+    /// count-over-area's `1/sqrt(λ)` for λ photons (a patch four times the area:
+    /// `1/(2·sqrt(λ))`).
+    #[test]
+    fn sparse_footprints_over_a_uniform_density_are_widened() {
+        let density = 2000.0;
+        let photons = field(density);
+        let store: KdStore<'_, 8> =
+            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        for lambda in [1.0, 2.0, 4.0] {
+            let h = 0.5 * libm::sqrtf(lambda / density); // (2h)² · density = λ
+            let mut g = Pcg32::new(3);
+            let estimates: Vec<f32> = (0..2000)
+                .map(|_| {
+                    let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
+                    store.irradiance_within(x, UnitVec3::Y, &square(h)).total.r / density
+                })
+                .collect();
+            let mean = estimates.iter().sum::<f32>() / 2000.0;
+            let var = estimates
+                .iter()
+                .map(|e| (e - mean) * (e - mean))
+                .sum::<f32>()
+                / 1999.0;
+            let spread = libm::sqrtf(var) * libm::sqrtf(lambda);
+            assert!((mean - 1.0).abs() < 0.04, "λ {lambda}: mean {mean}");
+            assert!(spread < 0.8, "λ {lambda}: spread × sqrt(λ) {spread}");
+        }
+    }
+
+    /// Next to a focus, an empty footprint is not widened into it: the patch twice its
+    /// size would hold the focus's photons in a quarter a uniform density would not
+    /// give them, and the estimate stays the sparse field's (here, none).
+    #[test]
+    fn a_sparse_footprint_beside_a_focus_is_not_widened_into_it() {
+        let density = 2000.0;
+        let photons = field(density);
+        let store: KdStore<'_, 8> =
+            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let h = 0.5 / libm::sqrtf(density);
+        let mut beside = 0;
+        for i in 0..40 {
+            // Centres 0.07–0.11 from the focus's centre: a patch of half-side 2h to
+            // 16h about them reaches into the focus.
+            let a = i as f32 * 0.157;
+            let d = 0.07 + 0.001 * i as f32;
+            let x = Vec3::new(0.3 + d * libm::cosf(a), 0.0, d * libm::sinf(a));
+            let region = Region::new(&square(h), 1.0).unwrap();
+            let mut unit = |_: UnitVec3, p: Rgb| p;
+            let (own, _, found) = store.sum_in(
+                Some(store.tree),
+                x,
+                UnitVec3::Y,
+                &region,
+                false,
+                Some(&mut unit),
+            );
+            if found != [0, 0] {
+                continue;
+            }
+            beside += 1;
+            let e = store.irradiance_within(x, UnitVec3::Y, &square(h)).total.r;
+            assert!(own[0].r + own[1].r == 0.0);
+            assert!(e < 3.0 * density, "footprint {i}: {e} against {density}");
+        }
+        assert!(beside > 10, "{beside} empty footprints");
+    }
+
     /// Every footprint's sums — one search or cut into disks, with the box that prunes
     /// the walk — are the brute-force sums over the photons inside its parallelogram
     /// that arrived on the front: photons near a tilted plane, some off it, some arriving
@@ -763,7 +985,7 @@ mod tests {
                     continue; // over the visit bound: the caller moves on
                 }
                 checked += 1;
-                counted += found;
+                counted += found[0] + found[1];
                 // Cut, segment j holds the photons within its own ball whose long
                 // coordinate is in [−1 + j·2/s, −1 + (j+1)·2/s), the last one closed.
                 let (s, along_b) = if cut { region.segments() } else { (1, false) };
@@ -780,7 +1002,7 @@ mod tests {
                         .length_squared()
                         .max((piece - short).length_squared())
                 };
-                let (mut want, mut count) = ([Rgb::ZERO; 2], 0);
+                let (mut want, mut count) = ([Rgb::ZERO; 2], [0u32; 2]);
                 for p in &photons {
                     let q = p.position() - x;
                     let inside = region.coords(q).is_some_and(|(alpha, beta)| {
@@ -791,7 +1013,7 @@ mod tests {
                     });
                     if inside && normal.dot(p.direction().get()) < 0.0 {
                         want[p.half() as usize] += p.power();
-                        count += 1;
+                        count[p.half() as usize] += 1;
                     }
                 }
                 assert_eq!(found, count, "footprint {q}, cut {cut}");
