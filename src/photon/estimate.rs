@@ -403,9 +403,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
     /// Sums `weight(photon)` over the photons inside the footprint that arrived on the
     /// front of the surface of normal `n` (no cone filter: the footprint is the
     /// kernel), over the area they cover: the density of the two halves, W per unit
-    /// area, or `None` for an empty or non-finite footprint. Unbiased for the patch's average
-    /// irradiance, whatever its size or shape, except where a sparse footprint is
-    /// [widened](Self::widened); the work is bounded by [`FOOTPRINT_VISITS`] photons
+    /// area, or `None` for an empty or non-finite footprint. Unbiased for the patch's
+    /// average irradiance, whatever its size or shape, except where a sparse footprint
+    /// is [widened](Self::widened); the work is bounded by [`FOOTPRINT_VISITS`] photons
     /// per search.
     #[inline(never)]
     fn gather_footprint(
