@@ -166,9 +166,10 @@ impl<const OBJECTS: usize, const LIGHTS: usize> Scene<OBJECTS, LIGHTS> {
     }
 }
 
-/// The next `f32` above a positive `x` (`+∞` stays).
+/// The next `f32` above a positive `x` (`+∞` stays): the reach that lets a later
+/// object win only when strictly nearer.
 #[inline]
-fn next_up(x: f32) -> f32 {
+pub(crate) fn next_up(x: f32) -> f32 {
     if x < f32::INFINITY {
         f32::from_bits(x.to_bits() + 1)
     } else {

@@ -162,7 +162,11 @@ impl Reach {
                 let i = set.trailing_zeros() as usize;
                 set &= set - 1;
                 // A later index must be strictly nearer; an earlier one wins a tie.
-                let reach = if index > i { next_up(best.t) } else { best.t };
+                let reach = if index > i {
+                    crate::scene::next_up(best.t)
+                } else {
+                    best.t
+                };
                 if let Some(h) = objects[i].shape.intersect(ray, reach) {
                     best = h;
                     index = i;
@@ -170,17 +174,6 @@ impl Reach {
             }
         }
         (index != usize::MAX).then_some((best, index))
-    }
-}
-
-/// The next `f32` above a positive `x` (`+∞` stays).
-#[cfg(feature = "std")]
-#[inline]
-fn next_up(x: f32) -> f32 {
-    if x < f32::INFINITY {
-        f32::from_bits(x.to_bits() + 1)
-    } else {
-        x
     }
 }
 
