@@ -585,9 +585,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
             return (sum, Some(0), [0; 2]);
         };
         let photons = tree.photons();
-        // Photons summed, and of them half 1's (no array indexed per photon: the
-        // counts stay in registers).
-        let (mut visited, mut found, mut found1) = (0usize, 0u32, 0u32);
+        let (mut visited, mut found) = (0usize, [0u32; 2]);
         let (segments, along_b) = if cut { region.segments() } else { (1, false) };
         let (long, short) = if along_b {
             (region.b, region.a)
@@ -640,18 +638,18 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                 if inside {
                     let dir = p.direction();
                     if n.dot(dir.get()) < 0.0 {
-                        sum[p.half() as usize] += weight(dir, p.power());
-                        found += 1;
-                        found1 += p.half() as u32;
+                        let h = p.half() as usize;
+                        sum[h] += weight(dir, p.power());
+                        found[h] += 1;
                     }
                 }
                 reach2
             });
             if visited > cap {
-                return (sum, None, [found - found1, found1]);
+                return (sum, None, found);
             }
         }
-        (sum, Some(visited), [found - found1, found1])
+        (sum, Some(visited), found)
     }
 }
 
@@ -820,7 +818,8 @@ mod tests {
     /// widening asks about (`c < 32`, `C` up to a device map's 1024), against tails
     /// summed in f64 from the binomial coefficients (decisions within 10⁻⁴ of the
     /// threshold skipped: f32 rounding may fall either way there), and every count
-    /// above `6c + 18` fails it, the bound that lets a widening search stop early.
+    /// above `6c + 18` fails it: the bound past which `uniform_quarter` refuses at once,
+    /// so that `(3/4)ⁿ` is never computed where it would underflow.
     #[test]
     fn the_uniformity_test_is_the_binomial_tails() {
         let pmf = |c: u32, n: u32| -> f64 {

@@ -14,7 +14,7 @@
 //!
 //! In a supersampled pixel the checkerboard halves gather over halves of its
 //! preimage, so their difference holds part of the gathers' noise; the sub-pixels'
-//! splits, averaged, are carried as well, since a grown sub-pixel footprint overlaps
+//! splits, averaged, are carried as well, since a widened sub-pixel footprint overlaps
 //! its neighbours'. Not estimated, and stated where it is reported: the gather's bias
 //! where the ray differentials' linear
 //! preimage of the pixel departs from the true one (at a silhouette or a fold of the

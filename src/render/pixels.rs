@@ -93,7 +93,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// `((m_a − m_b)/2)²` per channel: the batch-means estimate for two half-grids.
     /// The halves gather over halves of the pixel's preimage, so this holds part of the
     /// gathers' noise; the sub-pixels' own [`split`](Sample::split)s, averaged, are
-    /// carried too, because a sub-pixel footprint that grew
+    /// carried too, because a sub-pixel footprint that was widened
     /// ([`SPARSE_FOOTPRINT`](crate::photon::SPARSE_FOOTPRINT)) overlaps its neighbours
     /// and the halves then share photons (without it the sphere + wall scene's estimate
     /// fell to half its measured error).
