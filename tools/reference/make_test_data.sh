@@ -3,13 +3,13 @@
 # <name>.ref.caustic.pfm (caustic part, L S+ D S* E), 320x240: renders seeds 1 and 2 (in
 # parallel, one per core), commits their mean and writes the seed-to-seed noise with both
 # runs' statistics to tests/data/<name>.ref.json.
-# Usage: [PHOTONS=10000000] [SCENES="glass_sphere two_balls ..."] [ARGS="--spp-max 1024"] tools/reference/make_test_data.sh
+# Usage: [PHOTONS=20000000] [SCENES="glass_sphere two_balls ..."] [ARGS="--spp-max 1024"] tools/reference/make_test_data.sh
 #   scene names are scenes/<name>.json or scenes/heldout/<name>.json; intermediate parts go
 #   to $OUT (default /tmp/caustic-reference).
 set -euo pipefail
 HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 REPO="$(cd "$HERE/../.." && pwd)"
-PHOTONS="${PHOTONS:-10000000}"
+PHOTONS="${PHOTONS:-20000000}"
 OUT="${OUT:-${TMPDIR:-/tmp}/caustic-reference}"
 SCENES="${SCENES:-glass_sphere two_balls tube sphere_wall tilted_cube balls_mirror_tube}"
 ARGS="${ARGS:-}"  # extra arguments for run, e.g. "--spp-max 1024"
