@@ -13,11 +13,13 @@
 //! caustic region is the pixels whose reference caustic part is at least a tenth of
 //! their luminance. Each scene file's photons block is replaced by a plain one
 //! (`k` 64, `max_radius` 0.25, the k nearest): the estimator must be right without
-//! hints. `glass_sphere` and `two_balls` chose the defaults; `tube` was measured after.
-//! The three scenes are rendered once at 25k, 100k and 400k photons (the sweep) and
-//! every test reads those nine renders. Bounds are about 1.3 times the values measured
-//! when they were set, printed by `cargo test --release --test accuracy -- --nocapture`
-//! (the same figures at 320×240 and for the held-out scenes: `docs/error_calibration.csv`).
+//! hints. `glass_sphere` and `two_balls` chose the defaults; `tube` was measured after
+//! them and has since been tuned on too; the three scenes of `scenes/heldout/` never
+//! were. The six scenes are rendered once at 25k, 100k and 400k photons (the sweep) and
+//! every test reads those eighteen renders. Bounds are about 1.3 times the values
+//! measured when they were set (against the references re-rendered at 20M photons a
+//! light), printed by `cargo test --release --test accuracy -- --nocapture` (the same
+//! figures at 320×240: `docs/error_calibration.csv`).
 
 use caustic::desktop::image::{compare, Image};
 use caustic::desktop::{parse_scene, render_with_error, RenderOptions, Rendered};
@@ -41,10 +43,16 @@ fn reference(name: &str) -> (Image, Image) {
     (read("ref"), read("ref.caustic"))
 }
 
-/// `scenes/NAME.json` at 160×120 with a plain photons block of `count` photons.
+/// `scenes/NAME.json` (or `scenes/heldout/NAME.json`) at 160×120 with a plain photons
+/// block of `count` photons.
 fn render(name: &str, count: u32) -> Rendered {
     let root = env!("CARGO_MANIFEST_DIR");
-    let text = std::fs::read_to_string(format!("{root}/scenes/{name}.json")).unwrap();
+    let dir = if HELD_OUT.contains(&name) {
+        "scenes/heldout"
+    } else {
+        "scenes"
+    };
+    let text = std::fs::read_to_string(format!("{root}/{dir}/{name}.json")).unwrap();
     let loaded = parse_scene(&text).unwrap();
     let mut scene = loaded.scene;
     scene.set_camera(scene.camera().with_size(W, H).unwrap());
@@ -54,9 +62,13 @@ fn render(name: &str, count: u32) -> Rendered {
 
 /// The budgets of the sweep: 16 times from the first to the last.
 const BUDGETS: [u32; 3] = [25_000, 100_000, 400_000];
-/// The scenes of the sweep: `glass_sphere` and `two_balls` chose the defaults, `tube`
-/// was measured after.
+/// The tuning scenes of the sweep: `glass_sphere` and `two_balls` chose the defaults;
+/// `tube`, measured after them, has been among the scenes later changes were chosen on.
 const SCENES: [&str; 3] = ["glass_sphere", "two_balls", "tube"];
+
+/// The held-out scenes of the sweep (`scenes/heldout/`): written after the defaults by
+/// the references' author and never tuned to.
+const HELD_OUT: [&str; 3] = ["tilted_cube", "balls_mirror_tube", "sphere_wall"];
 
 /// One render of the sweep against its reference: relative RMSE measured and estimated,
 /// full image and caustic region.
@@ -121,6 +133,7 @@ fn sweep() -> &'static [Measured] {
     SWEEP.get_or_init(|| {
         SCENES
             .iter()
+            .chain(&HELD_OUT)
             .flat_map(|&name| BUDGETS.iter().map(move |&count| measure(name, count)))
             .collect()
     })
@@ -133,49 +146,64 @@ fn at(name: &str, count: u32) -> &'static Measured {
         .unwrap()
 }
 
-/// More photons, less error: 16 times the photons cut the caustic region's error 2.46
-/// times on the glass sphere and 2.49 times on the two balls when these bounds were
-/// set (4 times is the ideal of an unbiased estimate; the reference's own noise, 1–1.3%
-/// here after binning, is part of what is left). What keeps the two balls from doing
-/// better is known: behind a ball the floor is magnified, and the gather's footprint,
-/// taken from the pixel's ray cone without the lens's magnification, is wider than the
-/// pixel there (a bias at the focus seen through the glass).
+/// More photons, less error, on the tuning scenes: 16 times the photons cut the caustic
+/// region's error 4.2 times on the glass sphere, 3.1 times on the two balls and 3.9
+/// times on the tube against the 20M-photon references (4 times is the ideal of an
+/// unbiased estimate; the references' own noise, 0.9–1.3% here after binning, is part
+/// of what is left at 400k, and on the two balls the 4×4 grids' aliasing where a thin
+/// bright band crosses a pixel).
 #[test]
 fn the_caustics_converge_to_the_reference() {
-    for (name, bound, least_gain) in [("glass_sphere", 0.06, 2.0), ("two_balls", 0.075, 1.8)] {
-        let low = at(name, BUDGETS[0]);
-        let high = at(name, BUDGETS[2]);
-        assert!(high.caustic < bound, "{name}: {}", high.caustic);
-        let gain = low.caustic / high.caustic;
-        assert!(
-            gain > least_gain,
-            "{name}: the error fell only {gain:.2} times"
-        );
-        assert!(high.full < 0.6 * low.full, "{name}");
+    for (name, bound, least_gain) in [
+        ("glass_sphere", 0.023, 3.2),
+        ("two_balls", 0.035, 2.4),
+        ("tube", 0.052, 3.0),
+    ] {
+        converges(name, bound, least_gain);
     }
 }
 
-/// A scene the defaults were not chosen on, at its file's budget.
+/// The same on the held-out scenes, which no default or constant was chosen on: 4.6
+/// times (tilted cube) and 3.0 times (sphere + wall) for 16 times the photons, and on
+/// balls + mirror + tube 1.8 times, whose 400k render at this size holds photon noise
+/// that its own error estimate shows (0.024 estimated, 0.022 measured; at 320×240 the
+/// same budgets give 4.6 times).
 #[test]
-fn a_held_out_scene_meets_its_bound() {
-    let m = at("tube", 100_000);
+fn the_caustics_converge_on_held_out_scenes() {
+    for (name, bound, least_gain) in [
+        ("tilted_cube", 0.022, 3.5),
+        ("sphere_wall", 0.12, 2.3),
+        ("balls_mirror_tube", 0.029, 1.4),
+    ] {
+        converges(name, bound, least_gain);
+    }
+}
+
+/// Scene `name`'s caustic region at 400k photons is below `bound`, its error at 25k at
+/// least `least_gain` times that, and its full image's error falls too.
+fn converges(name: &str, bound: f64, least_gain: f64) {
+    let low = at(name, BUDGETS[0]);
+    let high = at(name, BUDGETS[2]);
+    assert!(high.caustic < bound, "{name}: {}", high.caustic);
+    let gain = low.caustic / high.caustic;
     assert!(
-        m.full < 0.05 && m.caustic < 0.14,
-        "{:.4} {:.4}",
-        m.full,
-        m.caustic
+        gain > least_gain,
+        "{name}: the error fell only {gain:.2} times"
     );
+    assert!(high.full < 0.6 * low.full, "{name}");
 }
 
 /// The render's own error estimate, full image and caustic region, is within a factor 2
-/// of the error measured against the reference, on every scene and budget of the
-/// sweep. The reference is noisy too, independently of the render, so
+/// of the error measured against the reference, on every tuning scene and budget of the
+/// sweep (on the held-out sphere + wall the estimate's caustic region holds pixels seen
+/// through the sphere that the reference's does not: README, "Estimated against
+/// measured"). The reference is noisy too, independently of the render, so
 /// `E[measured²] = true² + noise²`: its noise is subtracted in quadrature (it is 1–10%
 /// of the measured figures here, at most 0.3% / 1.0% absolute).
 #[test]
 fn the_error_estimate_is_calibrated() {
     let mut worst = (1.0f64, "");
-    for m in sweep() {
+    for m in sweep().iter().filter(|m| SCENES.contains(&m.name)) {
         let (noise_full, noise_caustic) = reference_noise(m.name);
         for (what, estimated, measured, noise) in [
             ("full", m.estimated_full, m.full, noise_full),
