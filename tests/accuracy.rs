@@ -149,7 +149,7 @@ fn at(name: &str, count: u32) -> &'static Measured {
 /// More photons, less error, on the tuning scenes: 16 times the photons cut the caustic
 /// region's error 4.2 times on the glass sphere, 3.1 times on the two balls and 3.9
 /// times on the tube against the 20M-photon references (4 times is the ideal of an
-/// unbiased estimate; the references' own noise, 0.9–1.3% here after binning, is part
+/// unbiased estimate; the references' own noise, 0.8–1.2% here after binning, is part
 /// of what is left at 400k, and on the two balls the 4×4 grids' aliasing where a thin
 /// bright band crosses a pixel).
 #[test]
@@ -198,8 +198,9 @@ fn converges(name: &str, bound: f64, least_gain: f64) {
 /// sweep (on the held-out sphere + wall the estimate's caustic region holds pixels seen
 /// through the sphere that the reference's does not: README, "Estimated against
 /// measured"). The reference is noisy too, independently of the render, so
-/// `E[measured²] = true² + noise²`: its noise is subtracted in quadrature (it is 1–10%
-/// of the measured figures here, at most 0.3% / 1.0% absolute).
+/// `E[measured²] = true² + noise²`: its noise is subtracted in quadrature (at most
+/// 0.4% / 1.2% absolute, full / caustic region, here; up to two thirds of the measured
+/// figure, on the glass sphere at 400k).
 #[test]
 fn the_error_estimate_is_calibrated() {
     let mut worst = (1.0f64, "");
