@@ -318,3 +318,47 @@ fn the_parallel_forward_pass_is_the_serial_one() {
         );
     }
 }
+
+/// A far, sun-like light sends as much power through a glass tube and a glass box as
+/// the same light fifty times nearer (each at intensity `∝ d²`, so the irradiance it
+/// brings is the same and its photons arrive nearly parallel): from 10⁴ units the
+/// shapes' bounding-sphere rejection once turned away half the photons aimed through the
+/// tube and a quarter of those through a box (its `|f|² − (f·d)²` cancelled), and the
+/// projection map counted both objects' cones for every photon, halving the tube's
+/// photons' power (a cone's cosine test rounds to 1 for half-angles below 3·10⁻⁴).
+/// Each alone fails this test (far/near 0.69 and 0.58).
+#[test]
+fn a_far_light_sends_its_photons_through_tubes_and_boxes() {
+    let stored_power = |distance: f32| {
+        let mut scene: Scene<3, 1> = Scene::new(camera());
+        add_floor(&mut scene, Rgb::ONE);
+        let glass = Material::dielectric(1.5, Rgb::ZERO).unwrap();
+        let tube = Shape::cylinder(Vec3::new(-1.0, 0.3, 0.0), Vec3::X, 0.3, 1.2, true);
+        let cube = Shape::cuboid(
+            Vec3::new(1.0, 0.6, 0.0),
+            Vec3::splat(0.4),
+            Vec3::new(0.0, 30.0, 10.0),
+        );
+        for shape in [tube, cube] {
+            scene.add(shape.unwrap(), glass).unwrap();
+        }
+        let towards = Vec3::new(0.3, 1.0, 0.2).normalize();
+        add_light(
+            &mut scene,
+            towards * distance,
+            Rgb::splat(distance * distance),
+        );
+        let settings = PhotonSettings::new(40_000, 64, 0.25, 4).unwrap();
+        let (map, unit, _) = photons(&scene, &settings, 3);
+        let total: f64 = map.iter().map(|p| p.power().r as f64 * unit as f64).sum();
+        (map.len(), total)
+    };
+    let (near_count, near) = stored_power(200.0);
+    let (far_count, far) = stored_power(1.0e4);
+    assert!(near_count > 15_000, "{near_count}");
+    let ratio = far / near;
+    assert!(
+        (ratio - 1.0).abs() < 0.02,
+        "stored power from 10^4 units {far} against 200 units {near} ({far_count} / {near_count} photons)"
+    );
+}
