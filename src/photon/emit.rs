@@ -40,7 +40,6 @@ pub(crate) struct Cone {
     axis: UnitVec3,
     e1: UnitVec3,
     e2: UnitVec3,
-    cos_max: f32,
     /// `1 − cos θ_max`, computed without cancellation as `sin²θ/(1 + cos θ)`.
     one_minus_cos: f32,
     solid_angle: f32,
@@ -75,7 +74,7 @@ impl Cone {
         }
         let [ax, ay, az] = v(self.axis.get());
         let between = libm::acos(((ax * x + ay * y + az * z) / d).clamp(-1.0, 1.0));
-        let half = libm::acos(self.cos_max as f64) + 1e-3;
+        let half = libm::acos(1.0 - self.one_minus_cos as f64) + 1e-3;
         between <= half + libm::asin(r / d)
     }
 }
@@ -128,7 +127,6 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 axis,
                 e1,
                 e2,
-                cos_max,
                 one_minus_cos,
                 solid_angle,
                 count: 0,
