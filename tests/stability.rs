@@ -243,10 +243,11 @@ proptest! {
         }
     }
 
-    /// Rays aimed at the shape from up to 10⁴ sizes away (a far, sun-like light) always hit it (closed shapes:
-    /// the target is inside), and the hit passes every check; a ray spawned back out
-    /// (leaving) never meets a convex shape again, and one spawned inwards (entering)
-    /// finds the far side of a closed shape, leaving it, with a positive distance.
+    /// Rays aimed at the shape from up to 10⁴ sizes away (a far, sun-like light) always
+    /// hit it (closed shapes: the target is inside), and the hit passes every check; a
+    /// ray spawned back out (leaving) never meets a convex shape again, and one spawned
+    /// inwards (entering) finds the far side of a closed shape, leaving it, with a
+    /// positive distance.
     #[test]
     fn aimed_rays_hit_and_spawned_rays_behave(
         (shape, s) in shape_strategy(),
