@@ -397,6 +397,7 @@ mod tests {
                 a: Vec3::new(s, 0.0, 0.1 * s),
                 b: Vec3::new(-0.1 * s, 0.0, s * sliver),
                 throughput: 1.0,
+                direct: 0.0,
             };
             let (e, c) = (
                 capped.irradiance_within(x, up, &f),

@@ -95,6 +95,7 @@ fn a_footprint_gathers_halves_estimate_its_error() {
             a: Vec3::new(0.06, 0.0, 0.0),
             b: Vec3::new(0.02, 0.0, 0.04),
             throughput: 1.0,
+            direct: 0.0,
         };
         let h = store.irradiance_within(x, UnitVec3::Y, &f);
         let to = (light - x).as_dvec3();

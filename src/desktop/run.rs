@@ -181,6 +181,9 @@ impl<S> Timed<'_, S> {
 }
 
 impl<S: CausticStore> CausticStore for Timed<'_, S> {
+    fn reads_direct(&self) -> bool {
+        self.inner.reads_direct()
+    }
     fn irradiance(&self, x: Vec3, n: UnitVec3) -> Rgb {
         self.time(|| self.inner.irradiance(x, n))
     }

@@ -18,7 +18,8 @@ mod splat;
 mod trace;
 
 pub use estimate::{
-    ConeFilter, Footprint, KdStore, FAINT, FOOTPRINT_VISITS, SPARSE_FOOTPRINT, THINNING,
+    ConeFilter, Footprint, KdStore, FAINT, FOOTPRINT_VISITS, MAGNIFIED, MAGNIFIED_WIDENINGS,
+    SPARSE_FOOTPRINT, THINNING,
 };
 
 pub use illumination::{
@@ -51,6 +52,13 @@ pub trait CausticStore {
 
     /// The caustic term of the paper's `classic` model (eq. 8) at `x`, seen from `to_eye`.
     fn classic(&self, x: Vec3, n: UnitVec3, to_eye: UnitVec3, material: &Classic) -> Rgb;
+
+    /// `true` when the store reads [`Footprint::direct`] (the desktop's kd-tree, which
+    /// widens sparse footprints seen magnified): the renderer works it out only then,
+    /// so a device's flash is spared it.
+    fn reads_direct(&self) -> bool {
+        false
+    }
 
     /// `false` only where every estimate at `x` is zero whatever the footprint (no
     /// photon can lie within reach): the renderer then does not work out the footprint

@@ -213,6 +213,17 @@ impl<const DEPTH: usize> Trail<DEPTH> {
         }
     }
 
+    /// The area the sample would cover on a surface seen directly, across the ray, at
+    /// the length `L` of the path at `depth` (its vertices, then `t`): `L²·A·step²`,
+    /// `A` a pixel's area on the image plane at distance 1 (its solid angle at the
+    /// image's centre).
+    #[inline]
+    pub fn direct_area(&self, camera: &Camera, depth: u32, t: f32) -> f32 {
+        let path = &self.vertices[..(depth as usize).min(self.vertices.len())];
+        let length = path.iter().fold(t, |l, v| l + v.t);
+        length * length * (camera.pixel_area() * (self.step * self.step))
+    }
+
     /// The differentials along the image's x and y of the branch at `depth` that left
     /// its last vertex along `dir` by `bend`: the camera's, carried through the first
     /// `depth` vertices (the two axes side by side, one copy of the code for both).

@@ -432,9 +432,19 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let (camera, objects) = (self.scene.camera(), self.scene.objects());
         let diffs = trail.differentials(camera, objects, b.depth, (b.ray.dir, b.bend));
         let throughput = b.weight.max_channel();
+        let direct = if self.store.reads_direct() {
+            trail.direct_area(camera, b.depth, hit.t)
+        } else {
+            0.0
+        };
         let [a, b] =
             diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
-        Gather::Footprint(Footprint { a, b, throughput })
+        Gather::Footprint(Footprint {
+            a,
+            b,
+            throughput,
+            direct,
+        })
     }
 
     /// Light leaving `hit` towards the eye directly, and up to two specular branches
