@@ -290,7 +290,7 @@ pub const MAGNIFIED_WIDENINGS: u32 = 8;
 /// the eye path alone, never on the photons, so choosing by it biases nothing. Measured
 /// (caustic region at 1.6M, four seeds): the tube 0.0386 → 0.0355, a second scene
 /// written afterwards (a glass cylinder, a flint ball and a mirror, two lights; two
-/// seeds) 0.0254 → 0.0221; the glass sphere, the two balls, the tilted cube and the
+/// seeds) 0.0254 → 0.0222; the glass sphere, the two balls, the tilted cube and the
 /// balls scene the same to three digits; whole runs the same time (paired ratios
 /// 0.99–1.00).
 pub const MAGNIFIED: f32 = 16.0;
