@@ -990,6 +990,32 @@ mod tests {
         }
     }
 
+    /// The estimates of `fp` about `n` random centres in `[−1.5, −0.5] × [−1, 1]` (PCG32
+    /// stream `seed`) over `density`, as fractions of it: their mean, their standard
+    /// deviation and the estimates themselves.
+    fn estimates(
+        store: &KdStore<'_, 8>,
+        fp: &Footprint,
+        density: f32,
+        n: usize,
+        seed: u64,
+    ) -> (f32, f32, Vec<f32>) {
+        let mut g = Pcg32::new(seed);
+        let estimates: Vec<f32> = (0..n)
+            .map(|_| {
+                let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
+                store.irradiance_within(x, UnitVec3::Y, fp).total.r / density
+            })
+            .collect();
+        let mean = estimates.iter().sum::<f32>() / n as f32;
+        let var = estimates
+            .iter()
+            .map(|e| (e - mean) * (e - mean))
+            .sum::<f32>()
+            / (n - 1) as f32;
+        (mean, libm::sqrtf(var), estimates)
+    }
+
     /// Over a uniform density, footprints that hold one to four photons are widened:
     /// their estimates average to the density (no bias: each half is summed over a
     /// patch the other half chose) with a spread well below the unwidened
@@ -1003,20 +1029,8 @@ mod tests {
             KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
         for lambda in [1.0, 2.0, 4.0] {
             let h = 0.5 * libm::sqrtf(lambda / density); // (2h)² · density = λ
-            let mut g = Pcg32::new(3);
-            let estimates: Vec<f32> = (0..2000)
-                .map(|_| {
-                    let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
-                    store.irradiance_within(x, UnitVec3::Y, &square(h)).total.r / density
-                })
-                .collect();
-            let mean = estimates.iter().sum::<f32>() / 2000.0;
-            let var = estimates
-                .iter()
-                .map(|e| (e - mean) * (e - mean))
-                .sum::<f32>()
-                / 1999.0;
-            let spread = libm::sqrtf(var) * libm::sqrtf(lambda);
+            let (mean, spread, _) = estimates(&store, &square(h), density, 2000, 3);
+            let spread = spread * libm::sqrtf(lambda);
             assert!((mean - 1.0).abs() < 0.04, "λ {lambda}: mean {mean}");
             assert!(spread < 0.8, "λ {lambda}: spread × sqrt(λ) {spread}");
         }
@@ -1040,20 +1054,7 @@ mod tests {
                 direct: if magnified { 4.0 * h * h * 1000.0 } else { 0.0 },
                 ..square(h)
             };
-            let mut g = Pcg32::new(5);
-            let estimates: Vec<f32> = (0..4000)
-                .map(|_| {
-                    let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
-                    store.irradiance_within(x, UnitVec3::Y, &fp).total.r / density
-                })
-                .collect();
-            let mean = estimates.iter().sum::<f32>() / 4000.0;
-            let var = estimates
-                .iter()
-                .map(|e| (e - mean) * (e - mean))
-                .sum::<f32>()
-                / 3999.0;
-            (mean, libm::sqrtf(var), estimates)
+            estimates(&store, &fp, density, 4000, 5)
         };
         let (mean, spread, _) = stats(0.01, true);
         assert!((mean - 1.0).abs() < 0.05, "magnified: mean {mean}");
