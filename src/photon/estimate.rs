@@ -567,6 +567,11 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         // Half h's density, once the other half has chosen its patch (`placed`).
         let (mut density, mut placed) = ([Rgb::ZERO; 2], [false; 2]);
         let mut next = region;
+        // The patch holds twice the sparse count (one half's luck aside: it is not
+        // sparse), or the next is out of reach: no widening past it.
+        let last = |r: &Region, found: [u32; 2]| {
+            found[0] + found[1] >= 2 * SPARSE_FOOTPRINT || r.reach2 * 4.0 > self.max_radius2
+        };
         for _ in 0..W + first.is_none() as u32 {
             if let Some((r, sum, found)) = kept {
                 let need = if W > 1 && r.area > region.area {
@@ -579,13 +584,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                         (density[h], placed[h]) = (sum[h] * (1.0 / r.area), true);
                     }
                 }
-                // Both halves placed, or the patch holds twice the sparse count (one
-                // half's luck aside: it is not sparse), or the next is out of reach.
-                let c = found[0] + found[1];
-                if placed == [true; 2]
-                    || c >= 2 * SPARSE_FOOTPRINT
-                    || r.reach2 * 4.0 > self.max_radius2
-                {
+                if placed == [true; 2] || last(&r, found) {
                     break;
                 }
                 next = r.scaled(4.0);
@@ -603,14 +602,10 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         }
         if N == usize::MAX && W == 1 && direct >= MAGNIFIED * region.area {
             // Where the loop above, given more widenings, would go on: past the first,
-            // sparse, the next within reach, a half whose other half holds no photon.
+            // not its last, a half whose other half holds no photon.
             if let (Some(first), Some((r, _, found))) = (first, kept) {
                 let waiting = (0..2).any(|h| !placed[h] && found[1 - h] == 0);
-                if r.area > region.area
-                    && waiting
-                    && found[0] + found[1] < 2 * SPARSE_FOOTPRINT
-                    && r.reach2 * 4.0 <= self.max_radius2
-                {
+                if r.area > region.area && waiting && !last(&r, found) {
                     return self.widened_far(x, n, region, first, weight);
                 }
             }
