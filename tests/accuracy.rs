@@ -196,8 +196,8 @@ fn converges(name: &str, bound: f64, least_gain: f64) {
 /// The render's own error estimate, full image and caustic region, is within a factor 2
 /// of the error measured against the reference, on every tuning scene and budget of the
 /// sweep (on the held-out sphere + wall the estimate's caustic region holds pixels seen
-/// through the sphere that the reference's does not: README, "Estimated against
-/// measured"). The reference is noisy too, independently of the render, so
+/// through the sphere that the reference's does not: docs/accuracy.md, "Estimated
+/// against measured"). The reference is noisy too, independently of the render, so
 /// `E[measured²] = true² + noise²`: its noise is subtracted in quadrature (at most
 /// 0.4% / 1.2% absolute, full / caustic region, here; up to two thirds of the measured
 /// figure, on the glass sphere at 400k).
