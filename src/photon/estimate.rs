@@ -630,7 +630,10 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         first: ([Rgb; 2], [u32; 2]),
         weight: &mut dyn FnMut(UnitVec3, Rgb) -> Rgb,
     ) -> Halves {
-        self.widened::<MAGNIFIED_WIDENINGS>(x, n, region, Some(first), 0.0, weight)
+        Halves {
+            widened: true,
+            ..self.widened::<MAGNIFIED_WIDENINGS>(x, n, region, Some(first), 0.0, weight)
+        }
     }
 
     /// The level to try first: the finest whose photons in the region's reach are
@@ -1063,6 +1066,36 @@ mod tests {
             .iter()
             .zip(&dense_plain)
             .all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    /// Only an estimate widened far past its footprint (a sparse one seen magnified)
+    /// says so: of the magnified footprints that hold 0.01 photons on average nearly all
+    /// need the far widening; an unmagnified one never takes it, nor does a magnified one
+    /// that holds photons enough.
+    #[test]
+    fn estimates_widened_far_say_so() {
+        let density = 2000.0;
+        let photons = field(density);
+        let store: KdStore<'_, 8> =
+            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let widened = |lambda: f32, magnified: bool| {
+            let h = 0.5 * libm::sqrtf(lambda / density);
+            let fp = Footprint {
+                direct: if magnified { 4.0 * h * h * 1000.0 } else { 0.0 },
+                ..square(h)
+            };
+            let mut g = Pcg32::new(9);
+            (0..1000)
+                .filter(|_| {
+                    let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
+                    store.irradiance_within(x, UnitVec3::Y, &fp).widened
+                })
+                .count()
+        };
+        let far = widened(0.01, true);
+        assert!(far > 900, "{far} of 1000");
+        assert_eq!(widened(0.01, false), 0);
+        assert_eq!(widened(40.0, true), 0);
     }
 
     /// Next to a focus, an empty footprint is not widened into it: the patch twice its

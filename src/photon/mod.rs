@@ -104,6 +104,11 @@ pub struct Halves {
     pub total: Rgb,
     /// Half 0's part minus half 1's.
     pub split: Rgb,
+    /// `true` when the photons were averaged over a patch widened far past the
+    /// footprint's own (`KdStore::widened_far`: a surface seen magnified near a lens's
+    /// focus, each sample's patch grown to the photons' spacing). Finer samples there
+    /// would average the same few photons again.
+    pub widened: bool,
 }
 
 impl Halves {
@@ -112,6 +117,7 @@ impl Halves {
         Self {
             total,
             split: Rgb::ZERO,
+            widened: false,
         }
     }
 
@@ -120,6 +126,7 @@ impl Halves {
         Self {
             total: self.total * s,
             split: self.split * s,
+            widened: self.widened,
         }
     }
 
@@ -128,6 +135,7 @@ impl Halves {
         Self {
             total: half0 + half1,
             split: half0 - half1,
+            widened: false,
         }
     }
 }

@@ -127,6 +127,11 @@ pub struct RayCount {
     pub shadow: u64,
     /// Pixels whose corners disagreed and were supersampled.
     pub refined: u64,
+    /// Gathers behind glass or a mirror whose photons were averaged over a patch widened
+    /// far past their own ([`Halves::widened`]: a surface seen magnified near a lens's
+    /// focus); counted only for a store that reads magnifications
+    /// ([`CausticStore::reads_direct`]).
+    pub widened: u64,
 }
 
 impl core::ops::AddAssign for RayCount {
@@ -134,6 +139,7 @@ impl core::ops::AddAssign for RayCount {
         self.eye += o.eye;
         self.shadow += o.shadow;
         self.refined += o.refined;
+        self.widened += o.widened;
     }
 }
 
@@ -560,6 +566,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             Gather::Store => Halves::whole(self.store.irradiance(hit.point, hit.normal)),
             Gather::Splatted | Gather::Dark => Halves::default(),
         };
+        // Constant false on a device's store: not compiled there.
+        if self.store.reads_direct() {
+            count.widened += caustic.widened as u64;
+        }
         let mut e = caustic.total;
         let logged = self.significant(b);
         for light in self.scene.lights() {
@@ -605,6 +615,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             Gather::Store => Halves::whole(self.store.classic(hit.point, n, to_eye, c)),
             Gather::Splatted | Gather::Dark => Halves::default(),
         };
+        // Constant false on a device's store: not compiled there.
+        if self.store.reads_direct() {
+            count.widened += caustic.widened as u64;
+        }
         log.caustic += b.weight * caustic.total;
         log.split += b.weight * caustic.split;
         ambient + lit + caustic.total

@@ -165,6 +165,8 @@ struct Rays {
     shadow: u64,
     /// Pixels whose corners disagreed and were supersampled.
     refined_pixels: u64,
+    /// Gathers whose photons were averaged over a patch widened far past their own.
+    widened_gathers: u64,
 }
 
 #[derive(Serialize)]
@@ -205,6 +207,7 @@ impl Stats {
                 eye: s.rays.eye,
                 shadow: s.rays.shadow,
                 refined_pixels: s.rays.refined,
+                widened_gathers: s.rays.widened,
             },
             photons: Photons {
                 emitted: s.photons_emitted,
