@@ -162,13 +162,13 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// explain: seen through a ball near its focus, each sub-pixel's patch is widened to
     /// the photons' spacing, many times the pixel's preimage, so the checkerboard halves
     /// differ by the few photons each half's patches hold, and a finer grid would only
-    /// average those photons again (`scenes/lens_wall.json`: 42% fewer eye rays, the
-    /// render's noise the same to 1%; the glass sphere's and the two balls' images the
-    /// same bits, the tube's caustic error 0.0356 → 0.0353 for 3% fewer eye rays; four
-    /// seeds at 1.6M photons). Elsewhere the
-    /// halves' photon noise stays in the test: there a finer grid's sparser sub-patches
-    /// widen more and do average more photons (subtracting it everywhere made the
-    /// tuning scenes' caustic errors 10–19% worse).
+    /// average those photons again. Measured at 1.6M photons, four seeds:
+    /// `scenes/lens_wall.json` 42% fewer eye rays, the render's noise the same to 1%;
+    /// the glass sphere's and the two balls' images the same bits; the tube's caustic
+    /// error 0.0356 → 0.0353 for 3% fewer eye rays. Elsewhere the halves' photon noise
+    /// stays in the test: there a finer grid's sparser sub-patches widen more and do
+    /// average more photons (subtracting it everywhere made the tuning scenes' caustic
+    /// errors 10–19% worse).
     fn refine(&self, x: u32, y: u32, n: u32, bright: f32, count: &mut RayCount) -> PixelEstimate {
         let start = count.eye + count.shadow;
         let cap = REFINE_RAYS as u64 * self.ray_budget as u64;
