@@ -213,6 +213,15 @@ impl<const DEPTH: usize> Trail<DEPTH> {
         }
     }
 
+    /// `true` when the camera ray's first hit was a refracting surface (glass, a
+    /// transparent `classic` object) met at an incidence cosine `|cos θ|` below `limit`.
+    #[inline]
+    pub fn grazes(&self, limit: f32) -> bool {
+        self.vertices
+            .first()
+            .is_some_and(|v| v.eta != 1.0 && v.d.dot(v.normal.get()).abs() < limit)
+    }
+
     /// The area the sample would cover on a surface seen directly, across the ray, at
     /// the length `L` of the path at `depth` (its vertices, then `t`): `L²·A·step²`,
     /// `A` a pixel's area on the image plane at distance 1 (its solid angle at the
@@ -365,6 +374,25 @@ mod tests {
     /// renderer walks it (a branch waits on a stack while its sibling records deeper
     /// vertices, then records its own over them): through the glass sphere and off the
     /// mirror of the device's glass scene, both image axes, a 2×2 grid's sub-pixel.
+    /// A ray entering a unit ball `x` from its axis meets it at `|cos θ| = √(1 − x²)`:
+    /// grazing below 0.15 only near the rim, never at a mirror, never without a hit.
+    #[test]
+    fn a_trail_knows_a_grazing_entry_into_glass() {
+        let ball = Shape::sphere(Vec3::ZERO, 1.0).unwrap();
+        let entry = |x: f32, eta: f32| {
+            let ray = Ray::new(Vec3::new(x, 0.0, 5.0), UnitVec3::new(-Vec3::Z).unwrap());
+            let hit = ball.intersect(&ray, f32::INFINITY).unwrap();
+            let mut trail = Trail::<2>::new(1.0);
+            trail.record(0, (ray.dir, Bend::Reflect), &hit, 0, eta);
+            trail.grazes(0.15)
+        };
+        assert!(!entry(0.0, 1.0 / 1.5)); // cos 1
+        assert!(!entry(0.98, 1.0 / 1.5)); // cos 0.199
+        assert!(entry(0.995, 1.0 / 1.5)); // cos 0.0999
+        assert!(!entry(0.995, 1.0)); // a mirror
+        assert!(!Trail::<2>::new(1.0).grazes(0.15));
+    }
+
     #[test]
     fn the_trail_replays_the_carried_differentials_bit_for_bit() {
         use crate::material::Material;

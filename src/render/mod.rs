@@ -77,7 +77,7 @@ mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{
-    CornerLine, RowPixel, Sampling, CONTRAST, REFINE, REFINE_RAYS, REFINE_TOLERANCE,
+    CornerLine, RowPixel, Sampling, CONTRAST, GRAZING, REFINE, REFINE_RAYS, REFINE_TOLERANCE,
     SIGNATURE_WEIGHT,
 };
 
@@ -353,12 +353,14 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// Radiance arriving at the origin of `ray` along it, with the path's signature.
     pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
-        self.sample_within(ray, 1, count)
+        self.sample_within(ray, 1, count).0
     }
 
     /// As [`sample`](Self::sample), for one ray of an `m × m` grid over the pixel: the
-    /// gathers behind glass average over its sub-pixel's patch of surface.
-    pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> Sample {
+    /// gathers behind glass average over its sub-pixel's patch of surface. Also `true`
+    /// when the ray entered glass at grazing incidence ([`GRAZING`]; only with a store
+    /// that reads magnifications, the desktop's: see `refine`).
+    pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> (Sample, bool) {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
         let mut trail = Trail::new(1.0 / m.max(1) as f32);
@@ -412,7 +414,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 None => break,
             }
         }
-        out
+        // Constant false on a device's store: not compiled there.
+        let grazing = self.store.reads_direct() && trail.grazes(GRAZING);
+        (out, grazing)
     }
 
     /// How the caustic store gathers at the diffuse point `hit` reached by branch `b`:
