@@ -369,11 +369,6 @@ mod tests {
     /// differentials carried to it.
     type Pending = (Ray, u32, Bend, [Differential; 2]);
 
-    /// Replaying the trail gives, bit for bit, the differentials carried through every
-    /// vertex, at every hit of every branch of a path tree walked depth first as the
-    /// renderer walks it (a branch waits on a stack while its sibling records deeper
-    /// vertices, then records its own over them): through the glass sphere and off the
-    /// mirror of the device's glass scene, both image axes, a 2×2 grid's sub-pixel.
     /// A ray entering a unit ball `x` from its axis meets it at `|cos θ| = √(1 − x²)`:
     /// grazing below 0.15 only near the rim, never at a mirror, never without a hit.
     #[test]
@@ -393,6 +388,11 @@ mod tests {
         assert!(!Trail::<2>::new(1.0).grazes(0.15));
     }
 
+    /// Replaying the trail gives, bit for bit, the differentials carried through every
+    /// vertex, at every hit of every branch of a path tree walked depth first as the
+    /// renderer walks it (a branch waits on a stack while its sibling records deeper
+    /// vertices, then records its own over them): through the glass sphere and off the
+    /// mirror of the device's glass scene, both image axes, a 2×2 grid's sub-pixel.
     #[test]
     fn the_trail_replays_the_carried_differentials_bit_for_bit() {
         use crate::material::Material;
