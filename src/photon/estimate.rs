@@ -988,6 +988,23 @@ mod tests {
         }
     }
 
+    /// A square footprint that holds `lambda` photons of `density` on average, seen
+    /// magnified 1000 times or not at all.
+    fn holding(lambda: f32, density: f32, magnified: bool) -> Footprint {
+        let h = 0.5 * libm::sqrtf(lambda / density); // (2h)² · density = λ
+        Footprint {
+            direct: if magnified { 4.0 * h * h * 1000.0 } else { 0.0 },
+            ..square(h)
+        }
+    }
+
+    /// `n` random centres in `[−1.5, −0.5] × [−1, 1]` on the plane `y = 0` (PCG32 stream
+    /// `seed`).
+    fn centres(n: usize, seed: u64) -> impl Iterator<Item = Vec3> {
+        let mut g = Pcg32::new(seed);
+        (0..n).map(move |_| Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0))
+    }
+
     /// The estimates of `fp` about `n` random centres in `[−1.5, −0.5] × [−1, 1]` (PCG32
     /// stream `seed`) over `density`, as fractions of it: their mean, their standard
     /// deviation and the estimates themselves.
@@ -998,12 +1015,8 @@ mod tests {
         n: usize,
         seed: u64,
     ) -> (f32, f32, Vec<f32>) {
-        let mut g = Pcg32::new(seed);
-        let estimates: Vec<f32> = (0..n)
-            .map(|_| {
-                let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
-                store.irradiance_within(x, UnitVec3::Y, fp).total.r / density
-            })
+        let estimates: Vec<f32> = centres(n, seed)
+            .map(|x| store.irradiance_within(x, UnitVec3::Y, fp).total.r / density)
             .collect();
         let mean = estimates.iter().sum::<f32>() / n as f32;
         let var = estimates
@@ -1026,8 +1039,8 @@ mod tests {
         let store: KdStore<'_, 8> =
             KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
         for lambda in [1.0, 2.0, 4.0] {
-            let h = 0.5 * libm::sqrtf(lambda / density); // (2h)² · density = λ
-            let (mean, spread, _) = estimates(&store, &square(h), density, 2000, 3);
+            let fp = holding(lambda, density, false);
+            let (mean, spread, _) = estimates(&store, &fp, density, 2000, 3);
             let spread = spread * libm::sqrtf(lambda);
             assert!((mean - 1.0).abs() < 0.04, "λ {lambda}: mean {mean}");
             assert!(spread < 0.8, "λ {lambda}: spread × sqrt(λ) {spread}");
@@ -1047,12 +1060,13 @@ mod tests {
         let store: KdStore<'_, 8> =
             KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
         let stats = |lambda: f32, magnified: bool| {
-            let h = 0.5 * libm::sqrtf(lambda / density); // (2h)² · density = λ
-            let fp = Footprint {
-                direct: if magnified { 4.0 * h * h * 1000.0 } else { 0.0 },
-                ..square(h)
-            };
-            estimates(&store, &fp, density, 4000, 5)
+            estimates(
+                &store,
+                &holding(lambda, density, magnified),
+                density,
+                4000,
+                5,
+            )
         };
         let (mean, spread, _) = stats(0.01, true);
         assert!((mean - 1.0).abs() < 0.05, "magnified: mean {mean}");
@@ -1079,17 +1093,9 @@ mod tests {
         let store: KdStore<'_, 8> =
             KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
         let widened = |lambda: f32, magnified: bool| {
-            let h = 0.5 * libm::sqrtf(lambda / density);
-            let fp = Footprint {
-                direct: if magnified { 4.0 * h * h * 1000.0 } else { 0.0 },
-                ..square(h)
-            };
-            let mut g = Pcg32::new(9);
-            (0..1000)
-                .filter(|_| {
-                    let x = Vec3::new(g.next_f32() - 1.5, 0.0, g.next_f32() * 2.0 - 1.0);
-                    store.irradiance_within(x, UnitVec3::Y, &fp).widened
-                })
+            let fp = holding(lambda, density, magnified);
+            centres(1000, 9)
+                .filter(|&x| store.irradiance_within(x, UnitVec3::Y, &fp).widened)
                 .count()
         };
         let far = widened(0.01, true);
