@@ -600,7 +600,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                 _ => kept = Some((next, sum, found)),
             }
         }
-        if N == usize::MAX && W == 1 && direct >= MAGNIFIED * region.area {
+        if self.reads_direct() && W == 1 && direct >= MAGNIFIED * region.area {
             // Where the loop above, given more widenings, would go on: past the first,
             // not its last, a half whose other half holds no photon.
             if let (Some(first), Some((r, _, found))) = (first, kept) {
@@ -765,7 +765,8 @@ fn bounds(photons: &[Photon]) -> (Vec3, Vec3) {
 }
 
 impl<const K: usize, const N: usize> CausticStore for KdStore<'_, K, N> {
-    /// Only a map of unbounded capacity widens magnified footprints (see `widened`).
+    /// Only a map of unbounded capacity widens magnified footprints (`widened` asks
+    /// this).
     #[inline]
     fn reads_direct(&self) -> bool {
         N == usize::MAX
