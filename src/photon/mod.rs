@@ -11,6 +11,7 @@
 
 mod emit;
 mod estimate;
+mod footprint;
 mod illumination;
 mod kdtree;
 mod packed;
@@ -18,10 +19,11 @@ mod splat;
 mod trace;
 
 pub use estimate::{
-    ConeFilter, Footprint, KdStore, FAINT, FOOTPRINT_VISITS, MAGNIFIED, MAGNIFIED_WIDENINGS,
-    SPARSE_FOOTPRINT, THINNING,
+    ConeFilter, KdStore, FAINT, FOOTPRINT_VISITS, MAGNIFIED, MAGNIFIED_WIDENINGS, SPARSE_FOOTPRINT,
+    THINNING,
 };
 
+pub use footprint::Footprint;
 pub use illumination::{
     FixedIlluminationMaps, IlluminationMaps, MapStats, TexelStorage, DEFAULT_TRIM,
 };
