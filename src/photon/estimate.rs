@@ -775,6 +775,11 @@ mod tests {
         assert!(checked > 30_000 && passed > 300, "{checked} {passed}");
     }
 
+    /// The store of radius 1 over a [`field`]'s photons (power unit 1, `K` = 8).
+    fn store_of(photons: &[Photon]) -> KdStore<'_, 8> {
+        KdStore::new(KdTree::from_balanced(photons), 1.0, None, 1.0, None)
+    }
+
     /// Photons over `[−2, 2]²` of the plane y = 0 at `density` per unit area, plus a
     /// disk of radius 0.05 about `(0.3, 0, 0)` 400 times as dense (a focus), each of
     /// power 1, in a store of radius 1.
@@ -858,8 +863,7 @@ mod tests {
     fn sparse_footprints_over_a_uniform_density_are_widened() {
         let density = 2000.0;
         let photons = field(density);
-        let store: KdStore<'_, 8> =
-            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         for lambda in [1.0, 2.0, 4.0] {
             let fp = holding(lambda, density, false);
             let (mean, spread, _) = estimates(&store, &fp, density, 2000, 3);
@@ -879,8 +883,7 @@ mod tests {
     fn sparse_magnified_footprints_widen_to_the_next_photons() {
         let density = 2000.0;
         let photons = field(density);
-        let store: KdStore<'_, 8> =
-            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         let stats = |lambda: f32, magnified: bool| {
             estimates(
                 &store,
@@ -912,8 +915,7 @@ mod tests {
     fn estimates_widened_far_say_so() {
         let density = 2000.0;
         let photons = field(density);
-        let store: KdStore<'_, 8> =
-            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         let widened = |lambda: f32, magnified: bool| {
             let fp = holding(lambda, density, magnified);
             centres(1000, 9)
@@ -933,8 +935,7 @@ mod tests {
     fn a_sparse_footprint_beside_a_focus_is_not_widened_into_it() {
         let density = 2000.0;
         let photons = field(density);
-        let store: KdStore<'_, 8> =
-            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         let h = 0.5 / libm::sqrtf(density);
         let mut beside = 0;
         for i in 0..40 {
