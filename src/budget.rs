@@ -61,14 +61,20 @@ pub struct DeviceBudget {
 
 impl DeviceBudget {
     /// The photon settings of this budget: [`emitted`](Self::emitted) photons per
-    /// light, [`k`](Self::k), [`max_radius`](Self::max_radius), [`depth`](Self::depth).
+    /// light, [`k`](Self::k), [`max_radius`](Self::max_radius), [`depth`](Self::depth),
+    /// one path per photon (no [glass splitting], which a device does not compile: it
+    /// would make splats beyond [`splats`](Self::splats) and cost flash), so that the
+    /// host renders a budget's image bit for bit as the device does.
+    ///
+    /// [glass splitting]: PhotonSettings::with_glass_splitting
     pub fn settings(&self) -> Result<PhotonSettings, Error> {
-        PhotonSettings::new(
+        Ok(PhotonSettings::new(
             self.emitted,
             self.k as u32,
             self.max_radius,
             self.depth as u32,
-        )
+        )?
+        .with_glass_splitting(false))
     }
 }
 
@@ -198,13 +204,15 @@ impl<const STORED: usize, const SPLATS: usize> DeviceMap<STORED, SPLATS> {
         *len = 0;
         splats.clear_splats();
         let result = photon::forward(scene, settings, seed, 0, |x| {
-            let slot = photons.get_mut(*len).ok_or(Error::Capacity {
-                what: "photons stored (budget::DeviceBudget::stored)",
-                requested: *len + 1,
-                capacity: STORED,
-            })?;
-            *slot = x.photon;
-            *len += 1;
+            if let Some(p) = x.photon {
+                let slot = photons.get_mut(*len).ok_or(Error::Capacity {
+                    what: "photons stored (budget::DeviceBudget::stored)",
+                    requested: *len + 1,
+                    capacity: STORED,
+                })?;
+                *slot = p;
+                *len += 1;
+            }
             match x.splat {
                 Some(s) => splats.push_splat(s),
                 None => Ok(()),

@@ -235,9 +235,13 @@ impl PhotonBuffer {
                         break;
                     };
                     let mut chunk = (vec::Vec::with_capacity(CHUNK as usize), vec::Vec::new());
-                    for x in (start..end).filter_map(|i| emitter.land(l, i)) {
-                        chunk.0.push(x.photon);
-                        chunk.1.extend(x.splat);
+                    for i in start..end {
+                        let landed = emitter.land(l, i, |x| {
+                            chunk.0.extend(x.photon);
+                            chunk.1.extend(x.splat);
+                            Ok::<(), core::convert::Infallible>(())
+                        });
+                        let Ok(()) = landed;
                     }
                     if let Ok(mut order) = order.lock() {
                         order.finish(k, chunk);

@@ -310,7 +310,9 @@ impl<S: TexelStorage, const OBJECTS: usize> IlluminationMaps<S, OBJECTS> {
         let settings = settings.with_camera_splats(false);
         let maps = self.build_with(scene, |f| {
             stats = forward(scene, &settings, seed, 0, |x| {
-                f(&x.photon, Some(x.object));
+                if let Some(p) = &x.photon {
+                    f(p, Some(x.object));
+                }
                 Ok(())
             })
             .unwrap_or_default();

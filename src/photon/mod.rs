@@ -167,6 +167,7 @@ pub struct PhotonSettings {
     store_direct: bool,
     fixed_radius: bool,
     splat: bool,
+    split: bool,
 }
 
 impl PhotonSettings {
@@ -192,6 +193,7 @@ impl PhotonSettings {
             store_direct: false,
             fixed_radius: false,
             splat: true,
+            split: true,
         })
     }
 
@@ -248,6 +250,23 @@ impl PhotonSettings {
     /// `true` when landed photons are connected to the eye.
     pub fn camera_splats(&self) -> bool {
         self.splat
+    }
+
+    /// Whether the light tracer's photons split at glass (the refracted path always
+    /// goes on with `1 − F` of the power, the reflected one with probability `F`; see
+    /// [`Emitter::land`]) instead of taking the photon store's Russian roulette path
+    /// alone. On by default, where the `std` feature compiles it; a device (without
+    /// `std`) never splits, its splat list a fixed budget. It matters only with
+    /// [`camera_splats`](Self::camera_splats) and glass; the stored photons are the same
+    /// either way.
+    pub fn with_glass_splitting(self, split: bool) -> Self {
+        Self { split, ..self }
+    }
+
+    /// `true` when the light tracer's photons split at glass where they can (see
+    /// [`with_glass_splitting`](Self::with_glass_splitting)).
+    pub fn glass_splitting(&self) -> bool {
+        self.split
     }
 
     /// A copy with another maximum radius (progressive passes shrink it).
@@ -436,16 +455,22 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         (0..self.plans.len()).map(|l| self.count(l) as u64).sum()
     }
 
-    /// Traces photon `i` of light `l` (`i < count(l)`): where it is stored, if anywhere.
-    pub fn photon(&self, l: usize, i: u32) -> Option<Photon> {
-        self.land(l, i).map(|x| x.photon)
-    }
-
-    /// Traces photon `i` of light `l` (`i < count(l)`): the photon to store, if it
-    /// landed, and (when the settings ask for camera splats) its splat if the eye sees
-    /// where it landed.
-    pub fn land(&self, l: usize, i: u32) -> Option<Landed> {
-        let half = &self.plans.get(l)?[(i & 1) as usize];
+    /// Traces photon `i` of light `l` (`i < count(l)`), handing `f` each place one of
+    /// its paths lands, in a fixed order: the photon to store on the one path Russian
+    /// roulette follows, and (when the settings ask for camera splats) each path's
+    /// splat if the eye sees where it landed. With splats, the paths split at glass
+    /// (see [`PhotonSettings::with_glass_splitting`]); without, the photon takes the
+    /// roulette's path alone. An error from `f` ends the photon and is returned.
+    pub fn land<E>(
+        &self,
+        l: usize,
+        i: u32,
+        mut f: impl FnMut(Landed) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let Some(halves) = self.plans.get(l) else {
+            return Ok(());
+        };
+        let half = &halves[(i & 1) as usize];
         let light = &self.scene.lights()[l];
         let (dir, power, index, cone) = half.plan.photon(light, i >> 1, half.shift);
         let power = power * half.share;
@@ -456,48 +481,40 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         );
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
-        let landing = trace::trace(
-            self.scene,
-            ray,
-            power,
-            s.max_depth,
-            s.store_direct,
-            &mut rng,
-            self.reach,
-            half.first_reach(self.reach, cone),
-        )?;
-        let material = &self.scene.objects()[landing.object].material;
-        let splat = if s.splat {
-            splat::connect(
-                self.scene,
-                &landing.hit,
-                material,
-                landing.dir,
-                landing.power,
-                i & 1 == 1,
-            )
-        } else {
-            None
-        };
-        Some(Landed {
-            photon: Photon::new(
-                landing.hit.point,
-                landing.dir,
-                landing.power * (1.0 / self.unit),
-            )
-            .with_half(i & 1 == 1),
-            object: landing.object,
-            splat,
+        let reach = (self.reach, half.first_reach(self.reach, cone));
+        let limits = (s.max_depth, s.store_direct, s.splat && s.split);
+        trace::trace(self.scene, ray, power, limits, &mut rng, reach, |landing| {
+            let material = &self.scene.objects()[landing.object].material;
+            let (hit, dir, half) = (&landing.hit, landing.dir, i & 1 == 1);
+            let splat = if s.splat {
+                let power = landing.power * landing.weight;
+                splat::connect(self.scene, hit, material, dir, power, half)
+            } else {
+                None
+            };
+            let photon = landing.stored.then(|| {
+                Photon::new(hit.point, dir, landing.power * (1.0 / self.unit)).with_half(half)
+            });
+            if photon.is_none() && splat.is_none() {
+                return Ok(());
+            }
+            let object = landing.object;
+            f(Landed {
+                photon,
+                object,
+                splat,
+            })
         })
     }
 }
 
-/// What one traced photon left: the photon to store, and its splat into the image when
-/// the eye sees where it landed.
+/// What one path of a traced photon left where it landed: the photon to store (on the
+/// path Russian roulette follows), and its splat into the image when the eye sees
+/// where it landed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Landed {
-    /// The photon for the caustic store.
-    pub photon: Photon,
+    /// The photon for the caustic store, on the roulette's path.
+    pub photon: Option<Photon>,
     /// Index of the scene object it landed on.
     pub object: usize,
     /// Its light-tracing contribution to the pixel it projects into.
@@ -523,10 +540,11 @@ pub fn forward<const O: usize, const L: usize>(
     };
     for l in 0..scene.lights().len() {
         for i in 0..emitter.count(l) {
-            if let Some(x) = emitter.land(l, i) {
+            emitter.land(l, i, |x| {
                 f(&x)?;
-                stats.stored += 1;
-            }
+                stats.stored += x.photon.is_some() as usize;
+                Ok(())
+            })?;
         }
     }
     Ok(stats)
@@ -544,7 +562,9 @@ pub fn for_each_photon<const O: usize, const L: usize>(
 ) -> ForwardStats {
     let settings = settings.with_camera_splats(false);
     forward(scene, &settings, seed, pass, |x| {
-        f(&x.photon);
+        if let Some(p) = &x.photon {
+            f(p);
+        }
         Ok(())
     })
     .unwrap_or_default()
@@ -571,8 +591,10 @@ pub fn shoot_with_splats<const O: usize, const L: usize>(
     splats.clear_splats();
     let mut n = 0;
     forward(scene, settings, seed, pass, |x| {
-        out[n] = x.photon;
-        n += 1;
+        if let Some(p) = x.photon {
+            out[n] = p;
+            n += 1;
+        }
         match x.splat {
             Some(s) => splats.push_splat(s),
             None => Ok(()),
