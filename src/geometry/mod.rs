@@ -230,6 +230,15 @@ impl Shape {
         !matches!(self, Shape::Plane(_))
     }
 
+    /// The plane, if the shape is one.
+    #[inline]
+    pub fn as_plane(&self) -> Option<&Plane> {
+        match self {
+            Shape::Plane(p) => Some(p),
+            _ => None,
+        }
+    }
+
     /// A sphere containing the shape; `None` for the unbounded plane.
     pub fn bounding_sphere(&self) -> Option<BoundingSphere> {
         match self {

@@ -15,6 +15,7 @@ mod footprint;
 mod illumination;
 mod kdtree;
 mod packed;
+mod reach;
 mod splat;
 mod trace;
 
@@ -359,7 +360,7 @@ pub struct Emitter<'a, const O: usize, const L: usize> {
     plans: heapless::Vec<[Half<O>; 2], L>,
     unit: f32,
     /// The scene's objects, for the photons' nearest-hit searches.
-    reach: trace::Reach,
+    reach: reach::Reaches<O>,
 }
 
 /// One half of a light's photons.
@@ -377,13 +378,13 @@ struct Half<const O: usize> {
 impl<const O: usize> Half<O> {
     /// The objects of `all` that the first segment of a photon of `cone` may meet.
     #[cfg(feature = "std")]
-    fn first_reach(&self, all: trace::Reach, cone: usize) -> trace::Reach {
+    fn first_reach(&self, all: reach::Reach, cone: usize) -> reach::Reach {
         all.within(self.reach.get(cone).copied().unwrap_or(u64::MAX))
     }
 
     /// Every object of `all`: a device tests them all.
     #[cfg(not(feature = "std"))]
-    fn first_reach(&self, all: trace::Reach, _: usize) -> trace::Reach {
+    fn first_reach(&self, all: reach::Reach, _: usize) -> reach::Reach {
         all
     }
 }
@@ -434,7 +435,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
             pass,
             plans,
             unit,
-            reach: trace::Reach::all(scene),
+            reach: reach::Reaches::new(scene),
         }
     }
 
@@ -481,7 +482,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         );
         let ray = Ray::new(light.position(), dir);
         let s = &self.settings;
-        let reach = (self.reach, half.first_reach(self.reach, cone));
+        let reach = (&self.reach, half.first_reach(self.reach.all, cone));
         let limits = (s.max_depth, s.store_direct, s.splat && s.split);
         trace::trace(self.scene, ray, power, limits, &mut rng, reach, |landing| {
             let material = &self.scene.objects()[landing.object].material;
