@@ -186,11 +186,28 @@ impl<const O: usize> Reaches<O> {
         Self { all, inside }
     }
 
+    /// The nearest hit of a segment tested against `reach`, or, when it starts inside
+    /// object `i` (`inside`), against what [`nearest_inside`](Self::nearest_inside)
+    /// finds it may meet.
+    #[inline(always)]
+    pub(crate) fn nearest<const L: usize>(
+        &self,
+        scene: &Scene<O, L>,
+        ray: &Ray,
+        reach: Reach,
+        inside: Option<usize>,
+    ) -> Option<(Hit, usize)> {
+        match inside {
+            Some(i) => self.nearest_inside(scene, ray, i),
+            None => reach.nearest(scene, ray),
+        }
+    }
+
     /// [`Reach::nearest`] over every object, for a ray that starts inside object `i`
     /// (its origin on or just inside `i`'s surface): the search over `i`'s set when
     /// both the origin and the hit lie in its ball, else over every object.
     #[inline]
-    pub(crate) fn nearest_inside<const L: usize>(
+    fn nearest_inside<const L: usize>(
         &self,
         scene: &Scene<O, L>,
         ray: &Ray,
@@ -233,15 +250,17 @@ impl<const O: usize> Reaches<O> {
         }
     }
 
-    /// [`Scene::intersect`]`(ray, ∞)`: a device tests every object.
+    /// [`Scene::intersect`]`(ray, ∞)`: a device tests every object, inside one or not
+    /// (the one search its flash holds).
     #[inline]
-    pub(crate) fn nearest_inside<const L: usize>(
+    pub(crate) fn nearest<const L: usize>(
         &self,
         scene: &Scene<O, L>,
         ray: &Ray,
-        _: usize,
+        reach: Reach,
+        _: Option<usize>,
     ) -> Option<(Hit, usize)> {
-        self.all.nearest(scene, ray)
+        reach.nearest(scene, ray)
     }
 }
 

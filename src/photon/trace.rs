@@ -134,10 +134,7 @@ fn follow<const O: usize, const L: usize>(
     // The object the segment starts inside of, if it goes into one.
     let mut inside = None;
     loop {
-        let (hit, index) = match inside {
-            Some(i) => all.nearest_inside(scene, &ray, i)?,
-            None => reach.nearest(scene, &ray)?,
-        };
+        let (hit, index) = all.nearest(scene, &ray, reach, inside)?;
         reach = all.all;
         let material = &scene.objects()[index].material;
         let front = hit.front_face(ray.dir);
