@@ -76,14 +76,26 @@ pub fn hammersley(i: u32, n: u32, shift: (f32, f32)) -> (f32, f32) {
 /// The radical inverse of `i` in base `b` ≥ 2: its base-`b` digits mirrored about the
 /// point, `Σ dⱼ·b^−(j+1)` (Halton 1960), in `[0, 1)`.
 #[inline]
-pub fn radical_inverse(mut i: u32, b: u32) -> f32 {
+pub fn radical_inverse(i: u32, b: u32) -> f32 {
+    below_one(add_digits(i, b, 0.0, 1.0 / b as f32))
+}
+
+/// `r` plus the base-`b` digits of `i`, the first weighted by `f` and each next by `1/b`
+/// times the one before: the radical inverse's loop, in its order of operations.
+#[inline(always)]
+const fn add_digits(mut i: u32, b: u32, mut r: f32, mut f: f32) -> f32 {
     let inv = 1.0 / b as f32;
-    let (mut r, mut f) = (0.0f32, inv);
     while i > 0 {
         r += (i % b) as f32 * f;
         i /= b;
         f *= inv;
     }
+    r
+}
+
+/// A radical inverse's sum kept below 1 (rounding can reach it).
+#[inline(always)]
+fn below_one(r: f32) -> f32 {
     if r >= 1.0 {
         1.0 - f32::EPSILON / 2.0
     } else {
@@ -179,13 +191,7 @@ impl<const B: u32, const N: usize> Digits<B, N> {
         let mut sums = [0.0f32; N];
         let mut j = 0;
         while j < N {
-            let (mut i, mut r, mut f) = (j as u32, 0.0f32, inv);
-            while i > 0 {
-                r += (i % B) as f32 * f;
-                i /= B;
-                f *= inv;
-            }
-            sums[j] = r;
+            sums[j] = add_digits(j as u32, B, 0.0, inv);
             j += 1;
         }
         let mut scale = inv;
@@ -200,19 +206,8 @@ impl<const B: u32, const N: usize> Digits<B, N> {
     /// `radical_inverse(i, B)`, the same bits.
     #[inline(always)]
     fn radical_inverse(&self, i: u32) -> f32 {
-        let inv = 1.0 / B as f32;
-        let mut r = self.sums[i as usize % N];
-        let (mut i, mut f) = (i / N as u32, self.scale);
-        while i > 0 {
-            r += (i % B) as f32 * f;
-            i /= B;
-            f *= inv;
-        }
-        if r >= 1.0 {
-            1.0 - f32::EPSILON / 2.0
-        } else {
-            r
-        }
+        let first = self.sums[i as usize % N];
+        below_one(add_digits(i / N as u32, B, first, self.scale))
     }
 }
 
