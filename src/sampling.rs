@@ -211,19 +211,15 @@ impl<const B: u32, const N: usize> Digits<B, N> {
     }
 }
 
-/// The tables of [`PATH_BASES`]: 3⁸, 5⁵, 7⁴ and 11³ entries, 54 KiB in all.
+/// The tables of [`PATH_BASES`] (3, 5, 7, 11): 3⁸, 5⁵, 7⁴ and 11³ entries, 54 KiB in all.
 #[cfg(feature = "std")]
-static DIGITS_3: Digits<3, 6561> = Digits::new();
+static DIGITS_3: Digits<{ PATH_BASES[0] }, 6561> = Digits::new();
 #[cfg(feature = "std")]
-static DIGITS_5: Digits<5, 3125> = Digits::new();
+static DIGITS_5: Digits<{ PATH_BASES[1] }, 3125> = Digits::new();
 #[cfg(feature = "std")]
-static DIGITS_7: Digits<7, 2401> = Digits::new();
+static DIGITS_7: Digits<{ PATH_BASES[2] }, 2401> = Digits::new();
 #[cfg(feature = "std")]
-static DIGITS_11: Digits<11, 1331> = Digits::new();
-#[cfg(feature = "std")]
-const _: () = assert!(PATH_BASES[0] == 3 && PATH_BASES[1] == 5 && PATH_BASES[2] == 7);
-#[cfg(feature = "std")]
-const _: () = assert!(PATH_BASES[3] == 11);
+static DIGITS_11: Digits<{ PATH_BASES[3] }, 1331> = Digits::new();
 
 /// Coordinate `dim` (< `PATH_BASES.len()`) of point `i`: see the `std` version.
 #[cfg(not(feature = "std"))]

@@ -144,7 +144,7 @@ struct Inside {
 /// the origin, by which [`Reaches`] widens bounding spheres and keeps other objects
 /// apart from them: far above the rounding of any hit point (about 10⁻⁶ of it).
 #[cfg(feature = "std")]
-pub(crate) const INSIDE_MARGIN: f32 = 1e-3;
+const INSIDE_MARGIN: f32 = 1e-3;
 
 #[cfg(feature = "std")]
 impl<const O: usize> Reaches<O> {
@@ -160,15 +160,15 @@ impl<const O: usize> Reaches<O> {
                 let radius = b.radius + margin;
                 let mut set = 0u64;
                 for (j, o) in objects.iter().enumerate() {
-                    let apart = match (spheres(j), o.shape.as_plane()) {
-                        (Some(s), _) => {
+                    // Every shape is bounded or a plane.
+                    let apart = match spheres(j) {
+                        Some(s) => {
                             let gap = radius + s.radius + margin;
                             (s.center - b.center).length_squared() > gap * gap
                         }
-                        (None, Some(p)) => {
+                        None => o.shape.as_plane().is_some_and(|p| {
                             p.normal().dot(b.center - p.point()).abs() > radius + margin
-                        }
-                        (None, None) => false,
+                        }),
                     };
                     if !apart {
                         set |= 1 << j;
