@@ -2,7 +2,7 @@
 
 use core::f32::consts::PI;
 
-use super::footprint::{Footprint, Region};
+use super::footprint::{Cut, Footprint, Region};
 use super::kdtree::{KdTree, Neighbor};
 use super::packed::Photon;
 use super::{CausticStore, Halves};
@@ -332,7 +332,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                 let scale = [1, THINNING, THINNING * THINNING][level] as f32 * self.unit;
                 return Some(Halves::from_parts(sum[0], sum[1]).scaled(scale / region.area));
             }
-            if !cut && region.segments().0 > 1 {
+            if !cut && region.cut().segments > 1 {
                 cut = true;
             } else if levels.get(level + 1).is_some_and(Option::is_some) {
                 level += 1;
@@ -503,12 +503,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         };
         let photons = tree.photons();
         let (mut visited, mut found) = (0usize, [0u32; 2]);
-        let (segments, along_b) = if cut { region.segments() } else { (1, false) };
-        let (long, short) = if along_b {
-            (region.b, region.a)
-        } else {
-            (region.a, region.b)
-        };
+        let how = if cut { region.cut() } else { Cut::WHOLE };
+        let segments = how.segments;
+        let (long, short) = how.axes(region);
         let step = 2.0 / segments as f32;
         let piece = long * (1.0 / segments as f32);
         // One segment searches the region's own reach (computed once, with it).
@@ -550,7 +547,7 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                 let inside = coordinates
                     .of(p.position() - x)
                     .is_some_and(|(alpha, beta)| {
-                        let t = if along_b { beta } else { alpha };
+                        let t = how.along(alpha, beta);
                         segments == 1 || (t >= lo && t < hi)
                     });
                 if inside {
@@ -657,6 +654,43 @@ mod tests {
     use crate::photon::balance;
     use crate::sampling::Pcg32;
     use std::vec::Vec;
+
+    /// A sliver whose half-axes are both long and nearly parallel — the differentials
+    /// of a ray entering glass at grazing incidence — is cut across its long diagonal,
+    /// into pieces whose reach is a fraction of the whole's; an unsheared one as before.
+    #[test]
+    fn a_sheared_sliver_is_cut_across_its_diagonal() {
+        let a = Vec3::new(0.1, 0.0, 0.0);
+        let b = Vec3::new(0.1, 0.0, 0.004);
+        let fp = |a, b| Footprint {
+            a,
+            b,
+            throughput: 1.0,
+            direct: 0.0,
+        };
+        let region = Region::new(&fp(a, b), 1.0).unwrap();
+        let cut = region.cut();
+        assert_eq!(cut.segments, 16);
+        let (long, short) = cut.axes(&region);
+        assert_eq!((long, short), (a + b, a - b));
+        let piece = long / cut.segments as f32;
+        let reach2 = (piece + short)
+            .length_squared()
+            .max((piece - short).length_squared());
+        assert!(
+            reach2 < region.reach2 / 50.0,
+            "{reach2} of {}",
+            region.reach2
+        );
+        // Its coordinate along the diagonal spans [−1, 1] over the parallelogram.
+        assert_eq!(cut.along(1.0, 1.0), 1.0);
+        assert_eq!(cut.along(-1.0, -1.0), -1.0);
+        assert_eq!(cut.along(1.0, -1.0), 0.0);
+        // A rectangle four times as long as wide: four pieces across `a`, as before.
+        let r = Region::new(&fp(a, Vec3::new(0.0, 0.0, 0.025)), 1.0).unwrap();
+        assert_eq!(r.cut().segments, 4);
+        assert_eq!(r.cut().axes(&r), (r.a, r.b));
+    }
 
     /// A footprint on a faint path is the brute-force sum over the first coarse level's
     /// photons inside it, each counted [`THINNING`] times (on a path below `FAINT²`, the
@@ -1019,12 +1053,9 @@ mod tests {
                 counted += found[0] + found[1];
                 // Cut, segment j holds the photons within its own ball whose long
                 // coordinate is in [−1 + j·2/s, −1 + (j+1)·2/s), the last one closed.
-                let (s, along_b) = if cut { region.segments() } else { (1, false) };
-                let (long, short) = if along_b {
-                    (region.b, region.a)
-                } else {
-                    (region.a, region.b)
-                };
+                let how = if cut { region.cut() } else { Cut::WHOLE };
+                let s = how.segments;
+                let (long, short) = how.axes(&region);
                 let piece = long / s as f32;
                 let r2 = if s == 1 {
                     region.reach2
@@ -1037,7 +1068,7 @@ mod tests {
                 for p in &photons {
                     let q = p.position() - x;
                     let inside = region.coordinates().of(q).is_some_and(|(alpha, beta)| {
-                        let t = if along_b { beta } else { alpha };
+                        let t = how.along(alpha, beta);
                         let j = (((t + 1.0) * s as f32 * 0.5) as u32).min(s - 1);
                         let centre = long * (-1.0 + (2 * j + 1) as f32 / s as f32);
                         (q - centre).length_squared() < r2
