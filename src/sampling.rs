@@ -93,6 +93,32 @@ const fn add_digits(mut i: u32, b: u32, mut r: f32, mut f: f32) -> f32 {
     r
 }
 
+/// How many levels of thinning by 16 point `j` of a Hammersley set `((j+½)/n, φ₂(j))`
+/// survives, 0 to 2, for the choice `c` (any `u32`; its low byte is used): level 2
+/// keeps the `j` whose four bytes XOR to `c`'s low byte, level 1 those whose eight
+/// nibbles XOR to the XOR of `c`'s two low nibbles (so level 2 lies in level 1).
+///
+/// For `c` uniform, each point is kept with probability exactly `16⁻ᵛ` (unbiased
+/// thinning), one point of every aligned block of `16ᵛ` indices. And the points kept
+/// are stratified in both coordinates: each `4v` consecutive bits of `j` are bound by
+/// the constraint to the others, so for `n = 2ᵐ` the kept points form a
+/// `(0, m − 4v, 2)`-net — one point in every dyadic box of area `16ᵛ/n`, whatever its
+/// shape (Niederreiter 1992's elementary intervals; the bits of `j` are `j/n`'s top
+/// bits and `φ₂(j)`'s bottom ones). Every 16th point instead fixes `j`'s low nibble,
+/// and with it the top four bits of `φ₂(j)`: one sixteenth of the second coordinate.
+#[inline]
+pub const fn thinning_level(j: u32, c: u32) -> usize {
+    let bytes = (j ^ j >> 8 ^ j >> 16 ^ j >> 24) & 0xff;
+    let c = c & 0xff;
+    if bytes == c {
+        2
+    } else if (bytes ^ bytes >> 4) & 0xf == (c ^ c >> 4) & 0xf {
+        1
+    } else {
+        0
+    }
+}
+
 /// A radical inverse's sum kept below 1 (rounding can reach it).
 #[inline(always)]
 fn below_one(r: f32) -> f32 {
@@ -242,6 +268,47 @@ fn wrap01(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thinning_keeps_one_point_in_every_elementary_box() {
+        // n = 2^12 points; level v keeps 2^(12 − 4v), one per dyadic box of every shape.
+        let m = 12u32;
+        for c in [0u32, 0x5a, 0xff, 0x13] {
+            for v in 1..=2usize {
+                let kept: std::vec::Vec<u32> = (0..1u32 << m)
+                    .filter(|&j| thinning_level(j, c) >= v)
+                    .collect();
+                let k = m - 4 * v as u32;
+                assert_eq!(kept.len(), 1 << k, "c {c:#x}, level {v}");
+                for a in 0..=k {
+                    // Boxes of 2^-a in j/n by 2^-(k − a) in φ₂(j): each holds one point.
+                    let mut seen = std::vec![0u32; 1 << k];
+                    for &j in &kept {
+                        let x = j >> (m - a);
+                        let y = (j.reverse_bits() >> (32 - m)) >> (m - (k - a));
+                        seen[((x << (k - a)) | y) as usize] += 1;
+                    }
+                    assert!(seen.iter().all(|&s| s == 1), "c {c:#x}, level {v}, a {a}");
+                }
+            }
+        }
+        // Every 16th point, as the levels were first taken, is no net: its points all
+        // share the top four bits of φ₂.
+        let stride: std::vec::Vec<u32> = (0..1u32 << m).step_by(16).collect();
+        assert!(stride.iter().all(|&j| j.reverse_bits() >> 28 == 0));
+    }
+
+    #[test]
+    fn thinning_keeps_every_point_with_probability_one_in_16_per_level() {
+        for j in [0u32, 1, 17, 4095, 123_456_789, u32::MAX] {
+            let mut count = [0u32; 3];
+            for c in 0..256 {
+                count[thinning_level(j, c)] += 1;
+            }
+            // Level ≥ 1 for 16 choices of 256, level 2 for one.
+            assert_eq!(count, [240, 15, 1], "j {j}");
+        }
+    }
 
     #[test]
     fn pcg_is_uniform_enough_and_streams_differ() {

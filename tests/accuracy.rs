@@ -147,7 +147,7 @@ fn at(name: &str, count: u32) -> &'static Measured {
 }
 
 /// More photons, less error, on the tuning scenes: 16 times the photons cut the caustic
-/// region's error 3.9 times on the glass sphere, 3.3 times on the two balls and 4.6
+/// region's error 4.1 times on the glass sphere, 3.7 times on the two balls and 5.1
 /// times on the tube against the 20M-photon references, each reference's own noise
 /// (0.8–1.2% here after binning) taken out in quadrature (4 times is the ideal of an
 /// unbiased estimate; on the two balls the 4×4 grids' aliasing where a thin bright band
@@ -165,17 +165,17 @@ fn the_caustics_converge_to_the_reference() {
     }
 }
 
-/// The same on the held-out scenes, which no default or constant was chosen on: 5.1
-/// times (tilted cube) and 4.3 times (sphere + wall) for 16 times the photons, and on
-/// balls + mirror + tube 2.1 times, whose 400k render at this size holds photon noise
-/// that its own error estimate shows (0.023 estimated, 0.018 measured; at 320×240 the
-/// same budgets give 4.6 times); the references' noise taken out as above.
+/// The same on the held-out scenes, which no default or constant was chosen on: 5.3
+/// times (tilted cube) and 4.2 times (sphere + wall) for 16 times the photons, and on
+/// balls + mirror + tube 2.6 times (2.0 while the coarse levels took every 16th photon,
+/// whose 400k render here read 0.0176; now 0.0146, about this reference's own noise at
+/// this size); the references' noise taken out as above.
 #[test]
 fn the_caustics_converge_on_held_out_scenes() {
     for (name, bound, least_gain) in [
         ("tilted_cube", 0.022, 3.5),
         ("sphere_wall", 0.12, 2.3),
-        ("balls_mirror_tube", 0.029, 1.4),
+        ("balls_mirror_tube", 0.029, 2.0),
     ] {
         converges(name, bound, least_gain);
     }
@@ -201,7 +201,7 @@ fn converges(name: &str, bound: f64, least_gain: f64) {
 }
 
 /// The render's own error estimate, full image and caustic region, is within a factor 2
-/// below and 2.5 above the error measured against the reference, on every tuning scene
+/// below and 3 above the error measured against the reference, on every tuning scene
 /// and budget of the sweep (on the held-out sphere + wall the estimate's caustic region
 /// holds pixels seen through the sphere that the reference's does not: docs/accuracy.md,
 /// "Estimated against measured"). The reference is noisy too, independently of the
@@ -209,10 +209,12 @@ fn converges(name: &str, bound: f64, least_gain: f64) {
 /// most 0.4% / 1.2% absolute, full / caustic region, here; up to 70% of the measured
 /// figure, on the glass sphere at 400k). Too low an estimate would stop
 /// `--target-error` early, too high one only renders longer: the upper bound is the
-/// looser. The worst, 2.2 on the glass sphere's caustic region at 400k, is the eye
-/// sampling's part (a checkerboard of a handful of pixels at the focus, the same 0.025
-/// as before the light tracer's photons split at glass), which the photons' error,
-/// fallen from 0.014 to 0.012, no longer hides.
+/// looser. The worst, 2.65 on the glass sphere's caustic region at 400k, is where the
+/// true error (0.0109) is below the reference's own noise (0.0116): the estimate, 0.0288,
+/// holds the eye sampling's part (a checkerboard of a handful of pixels at the focus)
+/// and, since the coarse levels keep both halves' photons (`thinning_level`), each
+/// half's own noise there (0.0249 before, when every 16th photon kept one half where
+/// all landed, and the measured error 0.0163, now 0.0159).
 #[test]
 fn the_error_estimate_is_calibrated() {
     let mut worst = (1.0f64, "");
@@ -229,7 +231,7 @@ fn the_error_estimate_is_calibrated() {
                 m.name, m.count
             );
             assert!(
-                (0.5..2.5).contains(&ratio),
+                (0.5..3.0).contains(&ratio),
                 "{} at {} photons, {what}: estimated {estimated:.4}, true {truth:.4}",
                 m.name,
                 m.count

@@ -12,8 +12,7 @@ use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
 use crate::error::within;
 use crate::photon::{
-    self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
-    Subtree, THINNING,
+    self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat, Subtree,
 };
 use crate::scene::Scene;
 use crate::Error;
@@ -143,22 +142,31 @@ impl<'a> Pool<'a> {
 struct InOrder<'a> {
     /// The first chunk not yet appended.
     next: usize,
-    /// Finished chunks waiting for an earlier one: photons and splats.
+    /// Finished chunks waiting for an earlier one.
     done: vec::Vec<Option<Chunk>>,
     photons: &'a mut vec::Vec<Photon>,
     splats: &'a mut vec::Vec<Splat>,
+    coarse: &'a mut [vec::Vec<Photon>; 2],
 }
 
-/// One chunk's photons and splats.
-type Chunk = (vec::Vec<Photon>, vec::Vec<Splat>);
+/// One chunk's photons, splats and the photons of each coarse level.
+#[derive(Default)]
+struct Chunk {
+    photons: vec::Vec<Photon>,
+    splats: vec::Vec<Splat>,
+    coarse: [vec::Vec<Photon>; 2],
+}
 
 impl InOrder<'_> {
     /// Chunk `k` is traced: appends it and every finished chunk after it that is due.
     fn finish(&mut self, k: usize, chunk: Chunk) {
         self.done[k] = Some(chunk);
-        while let Some((photons, splats)) = self.done.get_mut(self.next).and_then(Option::take) {
-            self.photons.extend_from_slice(&photons);
-            self.splats.extend_from_slice(&splats);
+        while let Some(c) = self.done.get_mut(self.next).and_then(Option::take) {
+            self.photons.extend_from_slice(&c.photons);
+            self.splats.extend_from_slice(&c.splats);
+            for (level, from) in self.coarse.iter_mut().zip(&c.coarse) {
+                level.extend_from_slice(from);
+            }
             self.next += 1;
         }
     }
@@ -220,11 +228,18 @@ impl PhotonBuffer {
         // while the others trace on.
         self.photons.clear();
         self.splats.clear();
+        self.coarse.iter_mut().for_each(vec::Vec::clear);
+        // The coarse levels: photons chosen by their emission index
+        // (`Emitter::coarse_levels`), each standing for THINNING of the level before.
+        // Only the footprint gathers behind glass read them, and those need the camera
+        // splats.
+        let coarse = settings.camera_splats();
         let order = Mutex::new(InOrder {
             next: 0,
             done: (0..items.len()).map(|_| None).collect(),
             photons: &mut self.photons,
             splats: &mut self.splats,
+            coarse: &mut self.coarse,
         });
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
@@ -234,11 +249,24 @@ impl PhotonBuffer {
                     let Some(&(l, start, end)) = items.get(k) else {
                         break;
                     };
-                    let mut chunk = (vec::Vec::with_capacity(CHUNK as usize), vec::Vec::new());
+                    let mut chunk = Chunk {
+                        photons: vec::Vec::with_capacity(CHUNK as usize),
+                        ..Chunk::default()
+                    };
                     for i in start..end {
                         let landed = emitter.land(l, i, |x| {
-                            chunk.0.extend(x.photon);
-                            chunk.1.extend(x.splat);
+                            if let Some(p) = x.photon {
+                                chunk.photons.push(p);
+                                let levels = if coarse {
+                                    emitter.coarse_levels(l, i)
+                                } else {
+                                    0
+                                };
+                                for level in &mut chunk.coarse[..levels] {
+                                    level.push(p);
+                                }
+                            }
+                            chunk.splats.extend(x.splat);
                             Ok::<(), core::convert::Infallible>(())
                         });
                         let Ok(()) = landed;
@@ -252,19 +280,6 @@ impl PhotonBuffer {
         });
         stats.emit_ms += ms(t.elapsed());
         let t = Instant::now();
-        // Every THINNING-th photon in emission order: a selection that does not depend
-        // on where the photons landed, so each stands for THINNING of them. Only the
-        // footprint gathers behind glass read them, and those need the camera splats.
-        let thin = |from: &[Photon]| -> vec::Vec<Photon> {
-            from.iter().step_by(THINNING).copied().collect()
-        };
-        let level1 = if settings.camera_splats() {
-            thin(&self.photons)
-        } else {
-            vec::Vec::new()
-        };
-        let level2 = thin(&level1);
-        self.coarse = [level1, level2];
         let (photons, coarse) = (&mut self.photons[..], &mut self.coarse);
         balance_parallel(photons, coarse, threads, pass, progress);
         stats.balance_ms += ms(t.elapsed());

@@ -184,6 +184,22 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         sets
     }
 
+    /// The index of the `index`-th photon in its cone's point set, and the cone (0 for
+    /// the sphere).
+    pub(crate) fn local(&self, index: u32) -> (u32, usize) {
+        let Emission::Cones(cones) = self else {
+            return (index, 0);
+        };
+        let mut local = index;
+        for (j, c) in cones.iter().enumerate() {
+            if local < c.count {
+                return (local, j);
+            }
+            local -= c.count;
+        }
+        (local, 0)
+    }
+
     /// Photons this plan emits.
     pub(crate) fn count(&self) -> u32 {
         match self {
@@ -232,16 +248,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power, index, 0)
             }
             Emission::Cones(cones) => {
-                // Find the cone this index falls into, then its local index.
-                let mut local = index;
-                let mut which = 0;
-                for (j, c) in cones.iter().enumerate() {
-                    if local < c.count {
-                        which = j;
-                        break;
-                    }
-                    local -= c.count;
-                }
+                let (local, which) = self.local(index);
                 let c = &cones[which];
                 let (s, t) = hammersley(local, c.count, shift);
                 let om = s * c.one_minus_cos; // 1 − cos θ

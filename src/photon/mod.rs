@@ -42,7 +42,7 @@ use crate::error::{in_range, positive, within, Error};
 use crate::geometry::Ray;
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::sampling::{hash, mix64, unit_f32, PathSampler};
+use crate::sampling::{hash, mix64, thinning_level, unit_f32, PathSampler};
 use crate::scene::Scene;
 
 /// The seam between the forward and the backward pass: how much caustic light arrives
@@ -454,6 +454,24 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
     /// Photons emitted by all lights.
     pub fn emitted(&self) -> u64 {
         (0..self.plans.len()).map(|l| self.count(l) as u64).sum()
+    }
+
+    /// How many coarse levels of the photon map photon `i` of light `l` joins, 0 to 2,
+    /// if it is stored ([`KdStore::with_coarse_levels`]): a function of `(seed, pass,
+    /// l, i)` alone, not of where photons land, so each photon of level `v` stands for
+    /// [`THINNING`]`ᵛ` of the map's. The point's index in its cone's Hammersley set is
+    /// thinned by [`thinning_level`] with a choice drawn per half: unbiased, and the
+    /// points kept stratified in both of the set's coordinates. Every 16th stored
+    /// photon, as these levels were first taken, kept one sixteenth of each cone's
+    /// azimuth where nearly every photon lands (a floor seen in a mirror read twice
+    /// its value, `docs/accuracy.md`), and one half's photons.
+    pub fn coarse_levels(&self, l: usize, i: u32) -> usize {
+        const _: () = assert!(THINNING == 16, "thinning_level thins by 16");
+        let Some(half) = self.plans.get(l).map(|p| &p[(i & 1) as usize]) else {
+            return 0;
+        };
+        let (j, _) = half.plan.local(i >> 1);
+        thinning_level(j, (half.key >> 40) as u32)
     }
 
     /// Traces photon `i` of light `l` (`i < count(l)`), handing `f` each place one of
