@@ -147,11 +147,7 @@ fn max_depth_ends_paths_at_a_further_specular_surface() {
 fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
     let (scene, mut settings) = small("glass_sphere.json", 64, 48);
     settings = PhotonSettings::new(20_000, 64, 0.05, settings.max_depth()).unwrap();
-    let mut stats = caustic::desktop::RenderStats::default();
-    let mut photons = PhotonBuffer::for_budget(&scene, &settings).unwrap();
-    photons
-        .fill(&scene, &settings, 1, 0, 2, &mut stats, &Progress::hidden())
-        .unwrap();
+    let photons = filled(&scene, &settings, 1);
     let store = photon::store_over::<128>(photons.tree(), photons.unit(), &settings).unwrap();
     let image = |cutoff: f32, budget: u32| {
         let r: Renderer<'_, _, { MAX_OBJECTS }, { MAX_LIGHTS }, { MAX_DEPTH }> =
@@ -312,6 +308,15 @@ fn small(name: &str, w: u32, h: u32) -> (DesktopScene, PhotonSettings) {
     )
 }
 
+/// The photon buffer of one forward pass (pass 0, seed `seed`, two threads).
+fn filled(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> PhotonBuffer {
+    let mut buf = PhotonBuffer::for_budget(scene, settings).unwrap();
+    let mut stats = caustic::desktop::RenderStats::default();
+    buf.fill(scene, settings, seed, 0, 2, &mut stats, &Progress::hidden())
+        .unwrap();
+    buf
+}
+
 fn bits(img: &caustic::desktop::Image) -> Vec<[u32; 3]> {
     img.pixels
         .iter()
@@ -362,10 +367,7 @@ fn images_are_bit_identical_whatever_the_thread_count() {
 #[test]
 fn rows_sharing_their_corners_are_the_rows() {
     let (scene, settings) = small("two_balls.json", 40, 30);
-    let mut buf = PhotonBuffer::for_budget(&scene, &settings).unwrap();
-    let mut stats = caustic::desktop::RenderStats::default();
-    buf.fill(&scene, &settings, 1, 0, 2, &mut stats, &Progress::hidden())
-        .unwrap();
+    let buf = filled(&scene, &settings, 1);
     let store = buf.store::<64>(&settings).unwrap();
     let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
         Renderer::new(&scene, &store, settings.max_depth())
@@ -804,10 +806,7 @@ fn the_program_writes_the_library_image_and_compares_it() {
 #[test]
 fn a_sliver_between_the_grids_rows_is_sampled() {
     let (scene, settings) = small("heldout/more/sphere_wall_c.json", 320, 240);
-    let mut buf = PhotonBuffer::for_budget(&scene, &settings).unwrap();
-    let mut stats = caustic::desktop::RenderStats::default();
-    buf.fill(&scene, &settings, 0, 0, 2, &mut stats, &Progress::hidden())
-        .unwrap();
+    let buf = filled(&scene, &settings, 0);
     let store = buf.store::<64>(&settings).unwrap();
     let pixel = |sampling| {
         let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =

@@ -302,7 +302,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// Pixel `(x, y)` from its four corner samples `c` (top left, top right, bottom
-    /// left, bottom right): their mean where they agree, else an `n × n` grid refined.
+    /// left, bottom right): their mean where they agree (the same paths' signatures,
+    /// luminances within [`CONTRAST`]: Mitchell 1987), else an `n × n` grid refined.
     fn adaptive(
         &self,
         x: u32,
@@ -311,7 +312,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         c: &[Sample; 4],
         count: &mut RayCount,
     ) -> PixelEstimate {
-        if agree(c) {
+        let paths_differ = c.iter().any(|s| s.signature != c[0].signature);
+        let contrast = contrasted(c);
+        if !paths_differ && !contrast {
             let mean = |f: fn(&Sample) -> Rgb| (f(&c[0]) + f(&c[1]) + f(&c[2]) + f(&c[3])) * 0.25;
             PixelEstimate {
                 radiance: mean(|s| s.radiance),
@@ -322,8 +325,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         } else {
             count.refined += 1;
             let bright = c.iter().map(|s| s.radiance.luminance()).fold(0.0, f32::max);
-            let edge = c.iter().any(|s| s.signature != c[0].signature) && contrasted(c);
-            self.refine(x, y, n, (bright, edge), count)
+            self.refine(x, y, n, (bright, paths_differ && contrast), count)
         }
     }
 
@@ -428,13 +430,6 @@ fn one(s: &Sample) -> PixelEstimate {
         split: s.split,
         ..PixelEstimate::default()
     }
-}
-
-/// `true` when four corner samples saw the same things and their luminances are within
-/// [`CONTRAST`] (Mitchell 1987's contrast, on luminance).
-fn agree(c: &[Sample; 4]) -> bool {
-    let s = c[0].signature;
-    !c.iter().any(|x| x.signature != s) && !contrasted(c)
 }
 
 /// `true` when the luminances of four corner samples differ by more than [`CONTRAST`]
