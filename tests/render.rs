@@ -797,6 +797,26 @@ fn the_program_writes_the_library_image_and_compares_it() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// The eye-sampled luminance (the light-traced splats aside) of pixel `(x, y)` of scene
+/// `name` at 320×240 and 20k photons (seed 0), under each of `samplings`: the same
+/// photons for all.
+fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f32; 3] {
+    let (scene, settings) = small(name, 320, 240);
+    let buf = filled(&scene, &settings, 0);
+    let store = buf.store::<64>(&settings).unwrap();
+    samplings.map(|sampling| {
+        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+            Renderer::new(&scene, &store, settings.max_depth())
+                .unwrap()
+                .with_sampling(sampling)
+                .unwrap()
+                .with_splats(buf.splats());
+        let mut row = vec![PixelEstimate::default(); 320];
+        r.row(y, &mut row);
+        row[x].radiance.luminance()
+    })
+}
+
 /// A sliver between the grid's rows: pixel (172, 72) of the sphere + wall c (320×240)
 /// has the wall at its top corners and the sphere's rim at its bottom ones, and through
 /// the last eighth of the pixel's height the rim shows a focus. Every sample of a 4×4
@@ -805,24 +825,14 @@ fn the_program_writes_the_library_image_and_compares_it() {
 /// 32×32 one within 5% (the reference's own average: 0.36, the wall alone 0.21).
 #[test]
 fn a_sliver_between_the_grids_rows_is_sampled() {
-    let (scene, settings) = small("heldout/more/sphere_wall_c.json", 320, 240);
-    let buf = filled(&scene, &settings, 0);
-    let store = buf.store::<64>(&settings).unwrap();
-    let pixel = |sampling| {
-        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
-            Renderer::new(&scene, &store, settings.max_depth())
-                .unwrap()
-                .with_sampling(sampling)
-                .unwrap()
-                .with_splats(buf.splats());
-        let mut row = vec![PixelEstimate::default(); 320];
-        r.row(72, &mut row);
-        row[172].radiance.luminance()
-    };
-    let (grid4, adaptive, grid32) = (
-        pixel(Sampling::Grid(4)),
-        pixel(Sampling::Adaptive(REFINE)),
-        pixel(Sampling::Grid(32)),
+    let [grid4, adaptive, grid32] = pixel_under(
+        "heldout/more/sphere_wall_c.json",
+        (172, 72),
+        [
+            Sampling::Grid(4),
+            Sampling::Adaptive(REFINE),
+            Sampling::Grid(32),
+        ],
     );
     assert!(
         grid4 < 0.8 * grid32,
@@ -836,30 +846,19 @@ fn a_sliver_between_the_grids_rows_is_sampled() {
 
 /// The focus seen through a ball's rim: pixel (143, 148) of the sphere + wall (320×240,
 /// 20k photons) looks through the sphere's lower rim at grazing incidence onto the
-/// focus under it. Of its eye-sampled part (the light-traced splats aside), a 16×16
-/// grid — where the grazing rule used to stop — reads 0.059, twice a 64×64 grid's
-/// 0.028 (the same photons); the adaptive sampling refines on to 32×32 and agrees with
-/// the 64×64 grid within 1.5% (0.0277).
+/// focus under it. Of its eye-sampled part, a 16×16 grid — where the grazing rule used
+/// to stop — reads 0.059, twice a 64×64 grid's 0.028 (the same photons); the adaptive
+/// sampling refines on to 32×32 and agrees with the 64×64 grid within 1.5% (0.0277).
 #[test]
 fn a_focus_seen_through_a_rim_refines_past_the_16x16_grid() {
-    let (scene, settings) = small("heldout/sphere_wall.json", 320, 240);
-    let buf = filled(&scene, &settings, 0);
-    let store = buf.store::<64>(&settings).unwrap();
-    let pixel = |sampling| {
-        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
-            Renderer::new(&scene, &store, settings.max_depth())
-                .unwrap()
-                .with_sampling(sampling)
-                .unwrap()
-                .with_splats(buf.splats());
-        let mut row = vec![PixelEstimate::default(); 320];
-        r.row(148, &mut row);
-        row[143].radiance.luminance()
-    };
-    let (grid16, adaptive, grid64) = (
-        pixel(Sampling::Grid(16)),
-        pixel(Sampling::Adaptive(REFINE)),
-        pixel(Sampling::Grid(64)),
+    let [grid16, adaptive, grid64] = pixel_under(
+        "heldout/sphere_wall.json",
+        (143, 148),
+        [
+            Sampling::Grid(16),
+            Sampling::Adaptive(REFINE),
+            Sampling::Grid(64),
+        ],
     );
     assert!(
         (grid16 - grid64).abs() > 0.05 * grid64,
