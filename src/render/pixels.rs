@@ -65,9 +65,9 @@ pub const GRAZING: f32 = 0.15;
 /// and this many budgets.
 pub const REFINE_RAYS: u32 = 16;
 
-/// The budgets of [`REFINE_RAYS`] for a pixel sent to the finest grid by a grazing
-/// sample ([`GRAZING`]), which may then refine once more, to `8n × 8n`, while its error
-/// estimate asks for it. On the desktop only (a device's flash keeps the old path).
+/// The budgets of [`REFINE_RAYS`] for a pixel one of whose first grid's samples grazed
+/// glass ([`GRAZING`]): its refinement may go on to `8n × 8n` while its error estimate
+/// asks for it. On the desktop only (a device's flash keeps the old path).
 pub const GRAZING_RAYS: u32 = 64;
 
 impl Sampling {
@@ -120,8 +120,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Also returned ([`Grid`]): the part of `((m_a − m_b)/2)²`'s luminance that the
     /// photons of samples [widened far](crate::photon::Halves::widened) explain,
     /// `¼·Σ_h Σ_{i∈h} split_i²/n_h²` (each sample's `split²` estimates its photons'
-    /// variance), which no finer grid lowers, and whether a sample that grazed glass
-    /// ([`GRAZING`]) gathered more than the pixel's value (see [`refine`](Self::refine)).
+    /// variance), which no finer grid lowers, whether a sample grazed glass
+    /// ([`GRAZING`]) and whether one that did gathered more than the pixel's value (see
+    /// [`refine`](Self::refine)).
     fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> Grid {
         let step = 1.0 / n as f32;
         let camera = self.scene.camera();
@@ -129,8 +130,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut split = Rgb::ZERO;
         // Per half, the photons' variance `split²` of its widened samples.
         let mut widened = [0.0f32; 2];
-        // The largest caustic part of a sample that grazed glass.
-        let mut grazing = 0.0f32;
+        // The largest caustic part of a sample that grazed glass, if one did.
+        let mut grazing: Option<f32> = None;
         // The signature every sample shares, if they all do.
         let mut shared = None;
         let mut uniform = true;
@@ -140,7 +141,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 let before = count.widened;
                 let (s, grazes) = self.sample_within(camera.ray_at(x, y, fx, fy), n, count);
                 if grazes {
-                    grazing = crate::math::max(grazing, s.caustic.luminance());
+                    let c = s.caustic.luminance();
+                    grazing = Some(grazing.map_or(c, |g| crate::math::max(g, c)));
                 }
                 uniform &= *shared.get_or_insert(s.signature) == s.signature;
                 let k = ((sx + sy) & 1) as usize;
@@ -179,7 +181,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             sampling2,
         };
         Grid {
-            grazing: grazing > pixel.radiance.luminance(),
+            grazing: grazing.is_some_and(|g| g > pixel.radiance.luminance()),
+            grazed: grazing.is_some(),
             uniform,
             pixel,
             photons,
@@ -199,16 +202,19 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// hold a focus: the sphere + wall c's pixel (172, 72) read 0.21 on a 4×4 grid,
     /// 0.35 on a 16×16 one and 32×32, 0.36 in its reference.
     ///
-    /// On the desktop a pixel sent there by a grazing sample refines once more, to
-    /// `8n × 8n`, while the error estimate asks for it, within [`GRAZING_RAYS`] budgets:
-    /// where the focus is seen through the rim a 16×16 grid is still too coarse. At 12.8M
-    /// photons the sphere + wall c's brightest rim pixel read 1.955 on 16×16 grids and
-    /// 2.074 on 32×32 (64×64 everywhere: 2.092; its reference 2.064), the caustic
-    /// region 0.103 → 0.077 (its reference's own noise 0.067). The tuning scenes have no
-    /// such pixels: their errors are the same to 1% at 1.6M and to 0.5% at 12.8M, for
-    /// 0.5–2.6% more rays; held out at 1.6M (four seeds), the sphere + wall 0.0490 →
-    /// 0.0448 (its worst seed 0.058 → 0.046) for 3.4% more rays, the balls scene 0.0174
-    /// → 0.0169 for 1.9%, the tilted cube the same.
+    /// On the desktop a pixel whose first grid has a sample that grazed glass refines on
+    /// to `8n × 8n` (from the `4n × 4n` grid too, where a grazing sample sent it), while
+    /// the error estimate asks for it, within [`GRAZING_RAYS`] budgets: seen through a
+    /// rim a 16×16 grid is still too coarse. Chosen on the tuning scenes (four seeds):
+    /// at 1.6M and 320×240 the two balls' caustic region 0.0350 → 0.0315 for 6.4% more
+    /// rays, the glass sphere 0.0218 → 0.0216 (+5.5%), the tube the same (+0.3%); at
+    /// 400k and 160×120 the glass sphere 0.0156 → 0.0141, the two balls 0.0161 →
+    /// 0.0157. Held out at 1.6M: the sphere + wall 0.0490 → 0.0445 (its worst seed
+    /// 0.058 → 0.046) for 6% more rays, the balls scene 0.0174 → 0.0155 for 13% more
+    /// (6% more wall time, paired), the tilted cube the same; at 12.8M the sphere + wall
+    /// c's brightest rim pixel reads 2.074 instead of 1.955 (64×64 everywhere: 2.092;
+    /// its reference 2.064), its caustic region 0.103 → 0.077 (the reference's own
+    /// noise 0.067).
     ///
     /// The error estimate here leaves out what the photons of samples widened far
     /// explain: seen through a ball near its focus, each sub-pixel's patch is widened to
@@ -236,6 +242,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut last = count.eye + count.shadow - start;
         // Constant false on a device's store: not compiled there.
         let missed = self.store.reads_direct() && edge && first.uniform;
+        let deep = GRAZING_RAYS as u64 * self.ray_budget as u64;
         let (mut m, top, cap) = if (first.grazing || missed) && 16 * last <= cap {
             let before = count.eye + count.shadow;
             let finest = self.grid(x, y, 4 * n, count);
@@ -245,8 +252,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             (p, photons) = (finest.pixel, finest.photons);
             last = count.eye + count.shadow - before;
-            let deep = GRAZING_RAYS as u64 * self.ray_budget as u64;
             (4 * n, 8 * n, deep)
+        } else if first.grazed && self.store.reads_direct() {
+            (n, 8 * n, deep)
         } else {
             (n, 4 * n, cap)
         };
@@ -444,6 +452,8 @@ struct Grid {
     photons: f32,
     /// A sample that grazed glass gathered more than the pixel's value.
     grazing: bool,
+    /// A sample grazed glass.
+    grazed: bool,
     /// Every sample saw the same objects along its path (the same signature).
     uniform: bool,
 }
