@@ -206,14 +206,14 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// to `8n × 8n` (from the `4n × 4n` grid too, where a grazing sample sent it), while
     /// the error estimate asks for it, within [`GRAZING_RAYS`] budgets: seen through a
     /// rim a 16×16 grid is still too coarse. Chosen on the tuning scenes (four seeds):
-    /// at 1.6M and 320×240 the two balls' caustic region 0.0350 → 0.0315 for 6.4% more
-    /// rays, the glass sphere 0.0218 → 0.0216 (+5.5%), the tube the same (+0.3%); at
-    /// 400k and 160×120 the glass sphere 0.0156 → 0.0141, the two balls 0.0161 →
+    /// at 1.6M and 320×240 the two balls' caustic region 0.0351 → 0.0315 for 6.8% more
+    /// rays, the glass sphere 0.0219 → 0.0216 (+8%), the tube 0.0306 → 0.0307 (+1%); at
+    /// 400k and 160×120 the glass sphere 0.0159 → 0.0141, the two balls 0.0158 →
     /// 0.0157. Held out at 1.6M: the sphere + wall 0.0490 → 0.0445 (its worst seed
     /// 0.058 → 0.046) for 6% more rays, the balls scene 0.0174 → 0.0155 for 13% more
     /// (6% more wall time, paired), the tilted cube the same; at 12.8M the sphere + wall
     /// c's brightest rim pixel reads 2.074 instead of 1.955 (64×64 everywhere: 2.092;
-    /// its reference 2.064), its caustic region 0.103 → 0.077 (the reference's own
+    /// its reference 2.064), its caustic region 0.103 → 0.086 (the reference's own
     /// noise 0.067).
     ///
     /// The error estimate here leaves out what the photons of samples widened far
