@@ -147,12 +147,12 @@ fn at(name: &str, count: u32) -> &'static Measured {
 }
 
 /// More photons, less error, on the tuning scenes: 16 times the photons cut the caustic
-/// region's error 5.6 times on the glass sphere, 4.3 times on the two balls and 5.3
+/// region's error 4.6 times on the glass sphere, 4.2 times on the two balls and 5.3
 /// times on the tube against the 20M-photon references, each reference's own noise
 /// (0.8–1.2% here after binning) taken out in quadrature (4 times is the ideal of an
 /// unbiased estimate; on the two balls the 4×4 grids' aliasing where a thin bright band
 /// crosses a pixel is part of what is left at 400k). As measured, with that noise in,
-/// the glass sphere's gain is only 3.3: its error at 400k, 0.014, is mostly the
+/// the glass sphere's gain is only 3.0: its error at 400k, 0.015, is mostly the
 /// reference's 0.011.
 #[test]
 fn the_caustics_converge_to_the_reference() {
@@ -166,9 +166,9 @@ fn the_caustics_converge_to_the_reference() {
 }
 
 /// The same on the held-out scenes, which no default or constant was chosen on: 5.3
-/// times (tilted cube) and 4.2 times (sphere + wall) for 16 times the photons, and on
+/// times (tilted cube) and 4.1 times (sphere + wall) for 16 times the photons, and on
 /// balls + mirror + tube 2.7 times (2.0 while the coarse levels took every 16th photon,
-/// whose 400k render here read 0.0176; now 0.0141, about this reference's own noise at
+/// whose 400k render here read 0.0176; now 0.0140, about this reference's own noise at
 /// this size); the references' noise taken out as above.
 #[test]
 fn the_caustics_converge_on_held_out_scenes() {

@@ -65,9 +65,10 @@ pub const GRAZING: f32 = 0.15;
 /// and this many budgets.
 pub const REFINE_RAYS: u32 = 16;
 
-/// The budgets of [`REFINE_RAYS`] for a pixel one of whose first grid's samples grazed
-/// glass ([`GRAZING`]): its refinement may go on to `8n × 8n` while its error estimate
-/// asks for it. On the desktop only (a device's flash keeps the old path).
+/// The budgets of [`REFINE_RAYS`] for a pixel whose first grid has a sample that grazed
+/// glass and gathered more than the pixel's value ([`GRAZING`]): its refinement may go
+/// on to `8n × 8n` while its error estimate asks for it. On the desktop only (a
+/// device's flash keeps the old path).
 pub const GRAZING_RAYS: u32 = 64;
 
 impl Sampling {
@@ -120,9 +121,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Also returned ([`Grid`]): the part of `((m_a − m_b)/2)²`'s luminance that the
     /// photons of samples [widened far](crate::photon::Halves::widened) explain,
     /// `¼·Σ_h Σ_{i∈h} split_i²/n_h²` (each sample's `split²` estimates its photons'
-    /// variance), which no finer grid lowers, whether a sample grazed glass
-    /// ([`GRAZING`]) and whether one that did gathered more than the pixel's value (see
-    /// [`refine`](Self::refine)).
+    /// variance), which no finer grid lowers, and whether a sample that grazed glass
+    /// ([`GRAZING`]) gathered more than the pixel's value (see [`refine`](Self::refine)).
     fn grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> Grid {
         let step = 1.0 / n as f32;
         let camera = self.scene.camera();
@@ -130,8 +130,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut split = Rgb::ZERO;
         // Per half, the photons' variance `split²` of its widened samples.
         let mut widened = [0.0f32; 2];
-        // The largest caustic part of a sample that grazed glass, if one did.
-        let mut grazing: Option<f32> = None;
+        // The largest caustic part of a sample that grazed glass.
+        let mut grazing = 0.0f32;
         // The signature every sample shares, if they all do.
         let mut shared = None;
         let mut uniform = true;
@@ -141,8 +141,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 let before = count.widened;
                 let (s, grazes) = self.sample_within(camera.ray_at(x, y, fx, fy), n, count);
                 if grazes {
-                    let c = s.caustic.luminance();
-                    grazing = Some(grazing.map_or(c, |g| crate::math::max(g, c)));
+                    grazing = crate::math::max(grazing, s.caustic.luminance());
                 }
                 uniform &= *shared.get_or_insert(s.signature) == s.signature;
                 let k = ((sx + sy) & 1) as usize;
@@ -181,8 +180,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             sampling2,
         };
         Grid {
-            grazing: grazing.is_some_and(|g| g > pixel.radiance.luminance()),
-            grazed: grazing.is_some(),
+            grazing: grazing > pixel.radiance.luminance(),
             uniform,
             pixel,
             photons,
@@ -202,19 +200,19 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// hold a focus: the sphere + wall c's pixel (172, 72) read 0.21 on a 4×4 grid,
     /// 0.35 on a 16×16 one and 32×32, 0.36 in its reference.
     ///
-    /// On the desktop a pixel whose first grid has a sample that grazed glass refines on
-    /// to `8n × 8n` (from the `4n × 4n` grid too, where a grazing sample sent it), while
-    /// the error estimate asks for it, within [`GRAZING_RAYS`] budgets: seen through a
-    /// rim a 16×16 grid is still too coarse. Chosen on the tuning scenes (four seeds):
-    /// at 1.6M and 320×240 the two balls' caustic region 0.0351 → 0.0315 for 6.8% more
-    /// rays, the glass sphere 0.0219 → 0.0216 (+8%), the tube 0.0306 → 0.0307 (+1%); at
-    /// 400k and 160×120 the glass sphere 0.0159 → 0.0141, the two balls 0.0158 →
-    /// 0.0157. Held out at 1.6M: the sphere + wall 0.0490 → 0.0445 (its worst seed
-    /// 0.058 → 0.046) for 6% more rays, the balls scene 0.0174 → 0.0155 for 13% more
-    /// (6% more wall time, paired), the tilted cube the same; at 12.8M the sphere + wall
-    /// c's brightest rim pixel reads 2.074 instead of 1.955 (64×64 everywhere: 2.092;
-    /// its reference 2.064), its caustic region 0.103 → 0.086 (the reference's own
-    /// noise 0.067).
+    /// On the desktop such a grazing pixel then refines on to `8n × 8n` while the error
+    /// estimate asks for it, within [`GRAZING_RAYS`] budgets — from its first grid where
+    /// that was too costly for the jump: seen through a rim a 16×16 grid is still too
+    /// coarse. Chosen on the tuning scenes (four seeds): at 1.6M and 320×240 the two
+    /// balls' caustic region 0.0351 → 0.0314 for 1.8% more rays (most of it from the
+    /// pixels too costly for the jump), the glass sphere 0.0219 → 0.0217 (+3.9%), the
+    /// tube 0.0306 → 0.0307 (+0.7%); at 400k and 160×120 the glass sphere 0.0172 →
+    /// 0.0154, the two balls the same (0.0173). Also refining every pixel with a grazing sample,
+    /// whatever it gathered, cost 4–7% more rays for the same errors. Held out at 1.6M:
+    /// the sphere + wall 0.0490 → 0.0446 (its worst seed 0.058 → 0.046) for 5% more
+    /// rays, the balls scene 0.0174 → 0.0155 for 5.6%, the tilted cube the same; at
+    /// 12.8M the sphere + wall c's brightest rim pixel reads 2.074 instead of 1.955
+    /// (64×64 everywhere: 2.092; its reference 2.064).
     ///
     /// The error estimate here leaves out what the photons of samples widened far
     /// explain: seen through a ball near its focus, each sub-pixel's patch is widened to
@@ -253,7 +251,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             (p, photons) = (finest.pixel, finest.photons);
             last = count.eye + count.shadow - before;
             (4 * n, 8 * n, deep)
-        } else if first.grazed && self.store.reads_direct() {
+        } else if first.grazing && self.store.reads_direct() {
             (n, 8 * n, deep)
         } else {
             (n, 4 * n, cap)
@@ -452,8 +450,6 @@ struct Grid {
     photons: f32,
     /// A sample that grazed glass gathered more than the pixel's value.
     grazing: bool,
-    /// A sample grazed glass.
-    grazed: bool,
     /// Every sample saw the same objects along its path (the same signature).
     uniform: bool,
 }
