@@ -207,11 +207,11 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// balls' caustic region 0.0351 → 0.0314 for 1.8% more rays (most of it from the
     /// pixels too costly for the jump), the glass sphere 0.0219 → 0.0217 (+3.9%), the
     /// tube 0.0306 → 0.0307 (+0.7%); at 400k and 160×120 the glass sphere 0.0172 →
-    /// 0.0154, the two balls the same (0.0173). Also refining every pixel with a grazing sample,
-    /// whatever it gathered, cost 4–7% more rays for the same errors. Held out at 1.6M:
-    /// the sphere + wall 0.0490 → 0.0446 (its worst seed 0.058 → 0.046) for 5% more
-    /// rays, the balls scene 0.0174 → 0.0155 for 5.6%, the tilted cube the same; at
-    /// 12.8M the sphere + wall c's brightest rim pixel reads 2.074 instead of 1.955
+    /// 0.0154, the two balls the same (0.0173). Also refining every pixel with a grazing
+    /// sample, whatever it gathered, cost 4–7% more rays for the same errors. Held out
+    /// at 1.6M: the sphere + wall 0.0490 → 0.0446 (its worst seed 0.058 → 0.046) for 5%
+    /// more rays, the balls scene 0.0174 → 0.0155 for 5.6%, the tilted cube the same;
+    /// at 12.8M the sphere + wall c's brightest rim pixel reads 2.074 instead of 1.955
     /// (64×64 everywhere: 2.092; its reference 2.064).
     ///
     /// The error estimate here leaves out what the photons of samples widened far
@@ -238,23 +238,27 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let first = self.grid(x, y, n, count);
         let (mut p, mut photons) = (first.pixel, first.photons);
         let mut last = count.eye + count.shadow - start;
-        // Constant false on a device's store: not compiled there.
+        // Both constant false on a device's store: not compiled there.
         let missed = self.store.reads_direct() && edge && first.uniform;
-        let deep = GRAZING_RAYS as u64 * self.ray_budget as u64;
-        let (mut m, top, cap) = if (first.grazing || missed) && 16 * last <= cap {
+        let deep = self.store.reads_direct() && first.grazing;
+        let (mut m, top) = if (first.grazing || missed) && 16 * last <= cap {
             let before = count.eye + count.shadow;
             let finest = self.grid(x, y, 4 * n, count);
-            // Constant false on a device's store: its path ends here, as before.
-            if !(first.grazing && self.store.reads_direct()) {
+            if !deep {
                 return finest.pixel;
             }
             (p, photons) = (finest.pixel, finest.photons);
             last = count.eye + count.shadow - before;
-            (4 * n, 8 * n, deep)
-        } else if first.grazing && self.store.reads_direct() {
-            (n, 8 * n, deep)
+            (4 * n, 8 * n)
+        } else if deep {
+            (n, 8 * n)
         } else {
-            (n, 4 * n, cap)
+            (n, 4 * n)
+        };
+        let cap = if deep {
+            GRAZING_RAYS as u64 * self.ray_budget as u64
+        } else {
+            cap
         };
         while m < top && m <= 32 {
             let e = p.sampling2.luminance() - photons;
