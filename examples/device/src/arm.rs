@@ -14,6 +14,7 @@ fn main() -> ! {
 #[exception]
 #[allow(unsafe_code)]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    crate::hprintln!("HARDFAULT pc={:#010x}", frame.pc());
+    use crate::semihosting::Part::{Hex, Text};
+    crate::semihosting::say(&[Text("HARDFAULT pc=0x"), Hex(frame.pc()), Text("\n")]);
     crate::semihosting::exit(false)
 }

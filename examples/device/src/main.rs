@@ -45,7 +45,8 @@ use caustic::budget::DeviceMap;
 use caustic::raster::{DisplaySink, Dither, Rgb565Stream, ToneMap};
 use caustic::render::Renderer;
 use estimate::{Pixel, Tally};
-use semihosting::HostFile;
+use semihosting::Part::{Dec, Hex, Text};
+use semihosting::{say, HostFile};
 
 /// The scene: Fig. 6 by default; `--features glass` builds the physical scene.
 #[cfg(not(feature = "glass"))]
@@ -211,34 +212,31 @@ fn count(n: u64) -> u32 {
     u32::try_from(n).unwrap_or(u32::MAX)
 }
 // The seed is printed as a `u32` (see `count`).
-const _: () = assert!(BUDGET.seed <= u32::MAX as u64);
+const _: () = assert!(BUDGET.seed >> 32 == 0);
 
 /// Stops with a failure. The core's `Error` is not formatted: its `Display` prints
 /// `f32` fields, and float formatting alone is about 16 KiB of flash. The host test
 /// (`tests/device.rs`) runs the same code and shows the error's text.
 fn fail(what: &str) -> ! {
-    say(&["FAIL ", what, "\n"]);
+    say(&[Text("FAIL "), Text(what), Text("\n")]);
     semihosting::exit(false)
-}
-
-/// Writes `parts` to the console as they are: strings go out without `{}`, whose
-/// `Display for str` (padding and precision) is 640 B of flash.
-fn say(parts: &[&str]) {
-    use core::fmt::Write as _;
-    for p in parts {
-        let _ = semihosting::Console.write_str(p);
-    }
 }
 
 /// The whole run; called by the platform's reset code.
 pub fn run() -> ! {
-    say(&["caustic on ", TARGET, ": ", scene::NAME, ", "]);
-    hprintln!(
-        "{}x{}, seed {}",
-        BUDGET.width,
-        BUDGET.height,
-        BUDGET.seed as u32
-    );
+    say(&[
+        Text("caustic on "),
+        Text(TARGET),
+        Text(": "),
+        Text(scene::NAME),
+        Text(", "),
+        Dec(BUDGET.width),
+        Text("x"),
+        Dec(BUDGET.height),
+        Text(", seed "),
+        Dec(BUDGET.seed as u32),
+        Text("\n"),
+    ]);
     let Statics { map, row, path } = take_statics().unwrap_or_else(|| fail("statics taken twice"));
     let path = semihosting::output_path(path, scene::FILE);
 
@@ -250,14 +248,19 @@ pub fn run() -> ! {
     let forward = map.build(&scene, &settings, BUDGET.seed);
     caustic_mark_photons_end();
     let forward = forward.unwrap_or_else(|_| fail("forward pass: over budget"));
-    hprintln!(
-        "photons: {} emitted, {} stored (capacity {}), {} seen by the eye (capacity {})",
-        count(forward.emitted),
-        forward.stored,
-        BUDGET.stored,
-        map.splats().len(),
-        BUDGET.splats
-    );
+    say(&[
+        Text("photons: "),
+        Dec(count(forward.emitted)),
+        Text(" emitted, "),
+        Dec(forward.stored as u32),
+        Text(" stored (capacity "),
+        Dec(BUDGET.stored as u32),
+        Text("), "),
+        Dec(map.splats().len() as u32),
+        Text(" seen by the eye (capacity "),
+        Dec(BUDGET.splats as u32),
+        Text(")\n"),
+    ]);
 
     let store = map
         .store::<{ BUDGET.k }>(&settings)
@@ -270,6 +273,8 @@ pub fn run() -> ! {
         Rgb565Stream::<_, WIDTH>::new(BUDGET.width, BUDGET.height, |b: &[u8]| file.write(b))
             .unwrap_or_else(|_| fail("display"));
 
+    // A unit struct without the error estimate, not with it: one constructor for both.
+    #[allow(clippy::default_constructed_unit_structs)]
     let mut tally = Tally::default();
     caustic_mark_render_begin();
     let rays = {
@@ -285,38 +290,48 @@ pub fn run() -> ! {
     let (pixels, hash, complete) = (stream.pixels(), stream.hash(), stream.is_complete());
     let _ = stream.into_writer(); // gives `file` back
     file.close().unwrap_or_else(|e| fail(e));
-    hprintln!(
-        "rays: {} eye, {} shadow",
-        count(rays.eye),
-        count(rays.shadow)
-    );
+    say(&[
+        Text("rays: "),
+        Dec(count(rays.eye)),
+        Text(" eye, "),
+        Dec(count(rays.shadow)),
+        Text(" shadow\n"),
+    ]);
     tally.report();
     let (stack, reserved) = stack_high_water();
-    hprintln!(
-        "stack high-water: {} bytes (of {} reserved)",
-        stack,
-        reserved
-    );
+    say(&[
+        Text("stack high-water: "),
+        Dec(stack as u32),
+        Text(" bytes (of "),
+        Dec(reserved as u32),
+        Text(" reserved)\n"),
+    ]);
     if !complete {
         fail("not every pixel was written");
     }
-    hprintln!(
-        "PASS fnv1a=0x{:08x} pixels={} stack={}",
-        hash,
-        pixels,
-        stack
-    );
+    say(&[
+        Text("PASS fnv1a=0x"),
+        Hex(hash),
+        Text(" pixels="),
+        Dec(pixels),
+        Text(" stack="),
+        Dec(stack as u32),
+        Text("\n"),
+    ]);
     semihosting::exit(true)
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     match info.location() {
-        Some(l) => {
-            say(&["PANIC at ", l.file(), ":"]);
-            hprintln!("{}", l.line())
-        }
-        None => hprintln!("PANIC"),
+        Some(l) => say(&[
+            Text("PANIC at "),
+            Text(l.file()),
+            Text(":"),
+            Dec(l.line()),
+            Text("\n"),
+        ]),
+        None => say(&[Text("PANIC\n")]),
     }
     semihosting::exit(false)
 }

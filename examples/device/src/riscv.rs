@@ -51,6 +51,13 @@ extern "C" fn caustic_riscv_trap() -> ! {
     unsafe {
         core::arch::asm!("csrr {0}, mcause", "csrr {1}, mepc", out(reg) cause, out(reg) pc);
     }
-    crate::hprintln!("TRAP mcause={:#x} mepc={:#010x}", cause, pc);
+    use crate::semihosting::Part::{Hex, Text};
+    crate::semihosting::say(&[
+        Text("TRAP mcause=0x"),
+        Hex(cause as u32),
+        Text(" mepc=0x"),
+        Hex(pc as u32),
+        Text("\n"),
+    ]);
     crate::semihosting::exit(false)
 }
