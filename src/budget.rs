@@ -406,6 +406,7 @@ mod tests {
                 b: Vec3::new(-0.1 * s, 0.0, s * sliver),
                 throughput: 1.0,
                 direct: 0.0,
+                curvature: 0.0,
             };
             let (e, c) = (
                 capped.irradiance_within(x, up, &f),

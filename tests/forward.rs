@@ -96,6 +96,7 @@ fn a_footprint_gathers_halves_estimate_its_error() {
             b: Vec3::new(0.02, 0.0, 0.04),
             throughput: 1.0,
             direct: 0.0,
+            curvature: 0.0,
         };
         let h = store.irradiance_within(x, UnitVec3::Y, &f);
         let to = (light - x).as_dvec3();

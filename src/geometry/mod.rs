@@ -224,6 +224,21 @@ impl Shape {
         }
     }
 
+    /// The largest principal curvature (1/scene units) of the surface at the point of
+    /// outward normal `n`: `1/r` on a sphere and on a cylinder's side, 0 on flat faces
+    /// (planes, box faces, caps). A patch of reach `ρ` about the point then lies within
+    /// the sagitta `ρ²κ/(1 + √(1 − ρ²κ²))` of its tangent plane (see
+    /// [`Footprint::curvature`](crate::photon::Footprint::curvature)).
+    #[inline]
+    pub fn curvature(&self, n: UnitVec3) -> f32 {
+        match self {
+            Shape::Sphere(s) => 1.0 / s.radius(),
+            // The caps' normals are ±axis; the side's are perpendicular to it.
+            Shape::Cylinder(c) if n.dot(c.axis().get()).abs() <= 0.5 => 1.0 / c.radius(),
+            Shape::Cylinder(_) | Shape::Box(_) | Shape::Plane(_) => 0.0,
+        }
+    }
+
     /// `false` for the unbounded plane.
     #[inline]
     pub fn is_bounded(&self) -> bool {
@@ -377,6 +392,59 @@ pub(crate) mod tests {
             }
         }
         assert!(hits > 5_000, "the rays must exercise hits too: {hits}");
+    }
+
+    /// A point of the same surface within distance `d` of a hit lies within `d²κ/2`
+    /// of the hit's tangent plane (`κ` = [`Shape::curvature`]), and on a sphere and a
+    /// cylinder's side reaches it: points found by rays along `−n` from the tangent
+    /// plane, on spheres, cylinders (side and caps), boxes and planes.
+    #[test]
+    fn the_curvature_bounds_the_surface_off_its_tangent_plane() {
+        let shapes = [
+            Shape::sphere(Vec3::new(0.0, 1.0, 0.0), 0.7).unwrap(),
+            Shape::cylinder(Vec3::ZERO, Vec3::new(0.2, 1.0, 0.1), 0.4, 1.5, true).unwrap(),
+            Shape::cuboid(
+                Vec3::ZERO,
+                Vec3::new(0.5, 2.0, 1.0),
+                Vec3::new(10.0, 20.0, 30.0),
+            )
+            .unwrap(),
+            Shape::plane(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.1, 1.0, 0.0)).unwrap(),
+        ];
+        let mut g = crate::sampling::Pcg32::new(12);
+        let (mut checked, mut tight) = (0, 0);
+        for _ in 0..4_000 {
+            let o = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) * 8.0 - Vec3::splat(4.0);
+            let aim = Vec3::new(g.next_f32(), g.next_f32(), g.next_f32()) - Vec3::splat(0.5);
+            let Some(dir) = UnitVec3::new(aim - o) else {
+                continue;
+            };
+            for s in &shapes {
+                let Some(h) = s.intersect(&Ray::new(o, dir), f32::INFINITY) else {
+                    continue;
+                };
+                let (n, kappa) = (h.normal, s.curvature(h.normal));
+                let (u, v) = n.basis();
+                let a = g.next_f32() * core::f32::consts::TAU;
+                let step = (u.get() * libm::cosf(a) + v.get() * libm::sinf(a)) * 0.1 * g.next_f32();
+                let probe = Ray::new(h.point + step + n.get() * 0.5, -n);
+                let Some(q) = s.intersect(&probe, 1.0) else {
+                    continue;
+                };
+                if q.normal.dot(n.get()) < 0.9 {
+                    continue; // another face, or the far side
+                }
+                let d = q.point - h.point;
+                let (off, bound) = (d.dot(n.get()).abs(), 0.5 * d.length_squared() * kappa);
+                assert!(off <= bound + 1e-5, "{s:?}: {off} > {bound}");
+                checked += 1;
+                tight += (kappa > 0.0 && off >= 0.9 * bound && off > 1e-4) as u32;
+            }
+        }
+        assert!(
+            checked > 1_000 && tight > 100,
+            "{checked} checked, {tight} tight"
+        );
     }
 
     #[test]

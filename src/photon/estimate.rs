@@ -508,21 +508,26 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         let (long, short) = how.axes(region);
         let step = 2.0 / segments as f32;
         let piece = long * (1.0 / segments as f32);
-        // One segment searches the region's own reach (computed once, with it).
-        let reach2 = if segments == 1 {
-            region.reach2
-        } else {
-            crate::math::max(
-                (piece + short).length_squared(),
-                (piece - short).length_squared(),
-            )
-        };
+        // A photon off the patch's surface is another surface's (`Region::thickness`);
+        // one on it lies within `thickness` of the plane, so within
+        // √(reach² + thickness²) of its segment's centre, `reach` along the plane (one
+        // segment's is the region's own, computed once with it).
+        let thickness = region.thickness(x);
+        let reach2 = thickness * thickness
+            + if segments == 1 {
+                region.reach2
+            } else {
+                crate::math::max(
+                    (piece + short).length_squared(),
+                    (piece - short).length_squared(),
+                )
+            };
         // A map small enough for one search gains nothing from the box (no level is
         // chosen by its count): a device's flash is spared it.
         let half2 = if N <= FOOTPRINT_VISITS {
             [f32::INFINITY; 3]
         } else {
-            region.box_half2(piece, short, reach2)
+            region.box_half2(piece, short, thickness)
         };
         let coordinates = region.coordinates();
         for j in 0..segments {
@@ -544,9 +549,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
                     return reach2;
                 };
                 let p = &photons[index];
-                let inside = coordinates
-                    .of(p.position() - x)
-                    .is_some_and(|(alpha, beta)| {
+                let q = p.position() - x;
+                let inside = q.dot(n.get()).abs() <= thickness
+                    && coordinates.of(q).is_some_and(|(alpha, beta)| {
                         let t = how.along(alpha, beta);
                         segments == 1 || (t >= lo && t < hi)
                     });
@@ -667,6 +672,7 @@ mod tests {
             b,
             throughput: 1.0,
             direct: 0.0,
+            curvature: 0.0,
         };
         let region = Region::new(&fp(a, b), 1.0).unwrap();
         let cut = region.cut();
@@ -737,6 +743,7 @@ mod tests {
                 b,
                 throughput: 0.5 * FAINT,
                 direct: 0.0,
+                curvature: 0.0,
             };
             let (sum, area) = brute(&level1, x, &faint);
             let want = sum * THINNING as f32 / area;
@@ -814,6 +821,119 @@ mod tests {
         KdStore::new(KdTree::from_balanced(photons), 1.0, None, 1.0, None)
     }
 
+    /// A floor's footprint by a wall counts the floor's photons alone: the wall's, on
+    /// the parallelogram's side of the corner and arriving downwards (on the floor's
+    /// front), lie off the floor's plane. Their density there is 20 times the floor's,
+    /// so counting the wall's photons within the footprint's reach would more than
+    /// double the estimate.
+    #[test]
+    fn a_floor_footprint_by_a_wall_counts_the_floor_alone() {
+        let mut g = Pcg32::new(5);
+        let down = UnitVec3::new(Vec3::new(0.0, -0.6, -0.8)).unwrap();
+        let mut photons: Vec<Photon> = Vec::new();
+        for i in 0..20_000 {
+            let floor = Vec3::new(g.next_f32() - 0.5, 0.0, -g.next_f32());
+            photons.push(Photon::new(floor, down, Rgb::splat(1.0)).with_half(i % 2 == 0));
+        }
+        for i in 0..40_000 {
+            let wall = Vec3::new(g.next_f32() - 0.5, g.next_f32() * 0.1, 0.0);
+            photons.push(Photon::new(wall, down, Rgb::splat(1.0)).with_half(i % 2 == 0));
+        }
+        balance(&mut photons);
+        let tree = KdTree::from_balanced(&photons);
+        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None);
+        // A square of half-side 0.05 about a point 0.02 from the wall: it reaches
+        // across the corner into the wall.
+        let x = Vec3::new(0.0, 0.0, -0.02);
+        let region = Region::new(&square(0.05), store.max_radius2).unwrap();
+        let mut weight = |_: UnitVec3, p: Rgb| p;
+        let (_, visits, found) = store.sum_in(
+            Some(tree),
+            x,
+            UnitVec3::Y,
+            &region,
+            false,
+            Some(&mut weight),
+        );
+        assert!(visits.is_some());
+        // The floor's, and the wall's within rounding of the floor (a hundredth of the
+        // reach and 10⁻⁴·0.02: the corner itself, a few photons).
+        let (mut floor, mut wall) = (0u32, 0u32);
+        for p in &photons {
+            let q = p.position() - x;
+            let within = q.x.abs() <= 0.05 && q.z.abs() <= 0.05;
+            let near = q.length_squared() <= region.reach2;
+            floor += (within && q.y <= 0.01 * region.reach2.sqrt() + 2e-6) as u32;
+            wall += (within && near && q.y > 0.0) as u32;
+        }
+        assert_eq!(found[0] + found[1], floor);
+        assert!(
+            wall > floor,
+            "{wall} wall photons in reach, {floor} on the floor"
+        );
+    }
+
+    /// On a ball the patch's photons lie off its tangent plane by up to the sagitta of
+    /// the reach, and they count: 4 000 photons spread evenly over a sphere of radius
+    /// 0.5 (few enough for one search's visits), square footprints at its top of
+    /// half-sides 0.1 and 0.3 (reaches `ρ` 0.14 and 0.42). At the larger, a corner's
+    /// photons lie 0.235 below the top — more than `ρ²κ/2` = 0.18, the sagitta of a
+    /// chord `ρ` rather than of a distance `ρ` along the plane — and 0.485 from it,
+    /// past a search ball of radius `ρ`. A flat surface's thickness would drop most
+    /// of them.
+    #[test]
+    fn a_curved_footprint_counts_its_surface_within_the_sagitta() {
+        let mut g = Pcg32::new(6);
+        let radius = 0.5;
+        let mut photons: Vec<Photon> = (0..4_000)
+            .map(|i| {
+                let z = g.next_f32() * 2.0 - 1.0;
+                let a = g.next_f32() * core::f32::consts::TAU;
+                let r = libm::sqrtf(1.0 - z * z);
+                let n = Vec3::new(r * libm::cosf(a), z, r * libm::sinf(a));
+                let dir = UnitVec3::new(-n).unwrap();
+                Photon::new(n * radius, dir, Rgb::splat(1.0)).with_half(i % 2 == 0)
+            })
+            .collect();
+        balance(&mut photons);
+        let tree = KdTree::from_balanced(&photons);
+        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None);
+        let x = Vec3::new(0.0, radius, 0.0);
+        let count = |half: f32, curvature: f32| {
+            let fp = Footprint {
+                curvature,
+                ..square(half)
+            };
+            let region = Region::new(&fp, store.max_radius2).unwrap();
+            let mut weight = |_: UnitVec3, p: Rgb| p;
+            let (_, visits, found) = store.sum_in(
+                Some(tree),
+                x,
+                UnitVec3::Y,
+                &region,
+                false,
+                Some(&mut weight),
+            );
+            assert!(visits.is_some());
+            found[0] + found[1]
+        };
+        for half in [0.1, 0.3] {
+            // The upper cap's photons whose projection lies in the square.
+            let want = photons
+                .iter()
+                .map(|p| p.position())
+                .filter(|q| q.y > 0.0 && q.x.abs() <= half && q.z.abs() <= half)
+                .count() as u32;
+            assert_eq!(count(half, 1.0 / radius), want, "half-side {half}");
+        }
+        let want = photons
+            .iter()
+            .map(|p| p.position())
+            .filter(|q| q.y > 0.0 && q.x.abs() <= 0.1 && q.z.abs() <= 0.1)
+            .count() as u32;
+        assert!(count(0.1, 0.0) < want / 4, "{} of {want}", count(0.1, 0.0));
+    }
+
     /// Photons over `[−2, 2]²` of the plane y = 0 at `density` per unit area, plus a
     /// disk of radius 0.05 about `(0.3, 0, 0)` 400 times as dense (a focus), each of
     /// power 1, in a store of radius 1.
@@ -846,6 +966,7 @@ mod tests {
             b: Vec3::new(0.0, 0.0, h),
             throughput: 1.0,
             direct: 0.0,
+            curvature: 0.0,
         }
     }
 
@@ -1000,9 +1121,10 @@ mod tests {
     }
 
     /// Every footprint's sums — one search or cut into disks, with the box that prunes
-    /// the walk — are the brute-force sums over the photons inside its parallelogram
-    /// that arrived on the front: photons near a tilted plane, some off it, some arriving
-    /// from behind, footprints from squares to slivers.
+    /// the walk — are the brute-force sums over the photons inside its parallelogram,
+    /// within its thickness of the plane (curvatures 0, 2 and 20), that arrived
+    /// on the front: photons near a tilted plane, some off it, some arriving from
+    /// behind, footprints from squares to slivers.
     #[test]
     fn footprint_sums_are_the_brute_force_sums() {
         let mut g = Pcg32::new(11);
@@ -1011,7 +1133,7 @@ mod tests {
         let mut photons: Vec<Photon> = (0..40_000)
             .map(|i| {
                 let (s, t) = (g.next_f32() * 4.0 - 2.0, g.next_f32() * 4.0 - 2.0);
-                let off = (g.next_f32() - 0.5) * 0.1;
+                let off = (g.next_f32() - 0.5) * 0.01;
                 let p = u.get() * s + v.get() * t + normal.get() * off;
                 let dir = if i % 5 == 0 {
                     normal.get()
@@ -1033,11 +1155,13 @@ mod tests {
             let long = (u.get() * c + v.get() * s) * (0.01 + 0.1 * g.next_f32());
             let short = (v.get() * c - u.get() * s) * [1.0, 0.2, 0.02][q % 3] * g.next_f32();
             let shear = long * (g.next_f32() - 0.5);
+            let curvature = [0.0, 2.0, 20.0][q % 3];
             let fp = Footprint {
                 throughput: 1.0,
                 a: long,
                 b: short + shear,
                 direct: 0.0,
+                curvature,
             };
             let Some(region) = Region::new(&fp, store.max_radius2) else {
                 continue;
@@ -1057,22 +1181,26 @@ mod tests {
                 let s = how.segments;
                 let (long, short) = how.axes(&region);
                 let piece = long / s as f32;
-                let r2 = if s == 1 {
-                    region.reach2
-                } else {
-                    (piece + short)
-                        .length_squared()
-                        .max((piece - short).length_squared())
-                };
+                let thickness = region.thickness(x);
+                let r2 = thickness * thickness
+                    + if s == 1 {
+                        region.reach2
+                    } else {
+                        (piece + short)
+                            .length_squared()
+                            .max((piece - short).length_squared())
+                    };
                 let (mut want, mut count) = ([Rgb::ZERO; 2], [0u32; 2]);
                 for p in &photons {
                     let q = p.position() - x;
-                    let inside = region.coordinates().of(q).is_some_and(|(alpha, beta)| {
-                        let t = how.along(alpha, beta);
-                        let j = (((t + 1.0) * s as f32 * 0.5) as u32).min(s - 1);
-                        let centre = long * (-1.0 + (2 * j + 1) as f32 / s as f32);
-                        (q - centre).length_squared() < r2
-                    });
+                    let on = q.dot(normal.get()).abs() <= thickness;
+                    let inside = on
+                        && region.coordinates().of(q).is_some_and(|(alpha, beta)| {
+                            let t = how.along(alpha, beta);
+                            let j = (((t + 1.0) * s as f32 * 0.5) as u32).min(s - 1);
+                            let centre = long * (-1.0 + (2 * j + 1) as f32 / s as f32);
+                            (q - centre).length_squared() < r2
+                        });
                     if inside && normal.dot(p.direction().get()) < 0.0 {
                         want[p.half() as usize] += p.power();
                         count[p.half() as usize] += 1;
@@ -1087,7 +1215,7 @@ mod tests {
         }
         std::eprintln!("{checked} footprints checked, {counted} photons counted");
         assert!(
-            checked > 300 && counted > 10_000,
+            checked > 300 && counted > 6_000,
             "{checked} footprints, {counted} photons"
         );
     }

@@ -31,6 +31,12 @@ pub struct Footprint {
     /// [`MAGNIFIED`](super::MAGNIFIED) lets a sparse patch widen past the first
     /// ([`MAGNIFIED_WIDENINGS`](super::MAGNIFIED_WIDENINGS)); 0 never does.
     pub direct: f32,
+    /// The surface's largest principal curvature at the patch, 1/scene units
+    /// ([`Shape::curvature`](crate::geometry::Shape::curvature); 0 where it is flat).
+    /// A photon of the same surface within reach `ρ` along the tangent plane lies
+    /// within the sagitta of that reach off the plane; one farther off lies on another
+    /// surface and is not counted (see `Region::thickness`).
+    pub curvature: f32,
 }
 
 /// Most disks one footprint's search is cut into (see `Region::segments`).
@@ -51,6 +57,8 @@ pub(super) struct Region {
     pub(super) area: f32,
     /// `false`: every photon within `reach2` counts (a degenerate parallelogram).
     parallelogram: bool,
+    /// The surface's curvature ([`Footprint::curvature`]).
+    curvature: f32,
 }
 
 impl Region {
@@ -84,6 +92,7 @@ impl Region {
                 reach2,
                 area: 4.0 * crate::math::sqrt(det),
                 parallelogram: true,
+                curvature: f.curvature,
             })
         } else {
             Some(Self {
@@ -95,6 +104,7 @@ impl Region {
                 reach2,
                 area: PI * reach2,
                 parallelogram: false,
+                curvature: f.curvature,
             })
         }
     }
@@ -112,7 +122,26 @@ impl Region {
             reach2: self.reach2 * s2,
             area: self.area * s2,
             parallelogram: self.parallelogram,
+            curvature: self.curvature,
         }
+    }
+
+    /// How far off the tangent plane at the region's centre `x` a photon counts: on a
+    /// surface of curvature `κ`, a point whose offset along the plane is at most the
+    /// reach `ρ` lies within the sagitta `ρ²κ / (1 + √(1 − ρ²κ²))` of that plane (the
+    /// height of a circle of radius `1/κ` at distance `ρ` from its tangent point;
+    /// `ρ²κ` past a hemisphere, `ρκ ≥ 1`); to that, `ρ/100` and `10⁻⁴·|x|∞` for the
+    /// rounding of hit points and of stored positions (2⁻¹⁷ of a coordinate,
+    /// [`Photon`](super::Photon)), both scaling with the scene. A photon farther off
+    /// lies on another surface — the wall at a floor's corner, a box's next face — and
+    /// is not the patch's: without this test a floor seen through a glass sphere next
+    /// to a wall read up to 8% over the independent reference there, which gathers
+    /// each object's photons alone (sphere + wall, `docs/accuracy.md`).
+    #[inline]
+    pub(super) fn thickness(&self, x: Vec3) -> f32 {
+        let (reach, bend) = (crate::math::sqrt(self.reach2), self.reach2 * self.curvature);
+        let rise = crate::math::max_num(1.0 - bend * self.curvature, 0.0);
+        bend / (1.0 + crate::math::sqrt(rise)) + 0.01 * reach + 1e-4 * crate::math::max_abs(x)
     }
 
     /// The coordinates of offsets from the centre, worked out once per search (see
@@ -128,17 +157,17 @@ impl Region {
 
     /// The squared half-extents, per axis, of a box about a segment's centre that holds
     /// every offset the segment counts: `α·long + β·short + γ·n` with `|α|, |β| ≤ 1`,
-    /// `n` the unit normal of the parallelogram's plane (its component along `n` is
-    /// ignored by [`Coordinates`], bounded only by the reach) — widened by
-    /// 10⁻⁴ against rounding; unbounded for a disk.
+    /// `n` the unit normal of the parallelogram's plane and `|γ|` at most `thickness`
+    /// (see [`thickness`](Self::thickness); [`Coordinates`] ignores the component along
+    /// `n`) — widened by 10⁻⁴ against rounding; unbounded for a disk.
     #[inline]
-    pub(super) fn box_half2(&self, long: Vec3, short: Vec3, reach2: f32) -> [f32; 3] {
+    pub(super) fn box_half2(&self, long: Vec3, short: Vec3, thickness: f32) -> [f32; 3] {
         let n = long.cross(short);
         let n2 = n.length_squared();
         if !self.parallelogram || !(n2 > 0.0) {
             return [f32::INFINITY; 3];
         }
-        let n = n * (crate::math::sqrt(reach2 / n2));
+        let n = n * (thickness / crate::math::sqrt(n2));
         let (l, s, n) = (long.abs(), short.abs(), n.abs());
         let e = (l + s + n) * 1.0001;
         (e * e).to_array()

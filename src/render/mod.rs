@@ -64,7 +64,7 @@
 use heapless::Vec as FixedVec;
 
 use crate::error::Error;
-use crate::geometry::{Hit, Ray};
+use crate::geometry::{Hit, Ray, Shape};
 use crate::material::{interface, Classic, Material};
 use crate::math::{reflect, Rgb, UnitVec3};
 use crate::photon::{CausticStore, Footprint, Halves, Splat};
@@ -424,18 +424,18 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// the branch's differentials there (replayed from the `trail`, and only where a
     /// photon may lie within reach).
     #[inline(always)]
-    fn gather(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
+    fn gather(&self, b: &Branch, (hit, shape): (&Hit, &Shape), trail: &Trail<DEPTH>) -> Gather {
         match self.splats {
             None => Gather::Store,
             Some(_) if b.depth == 0 => Gather::Splatted,
-            Some(_) => self.behind(b, hit, trail),
+            Some(_) => self.behind(b, (hit, shape), trail),
         }
     }
 
     /// The gather at `hit` seen through glass or in a mirror along `b`: over the
     /// half-steps of its differentials there, where a photon may lie within reach.
     #[inline(never)]
-    fn behind(&self, b: &Branch, hit: &Hit, trail: &Trail<DEPTH>) -> Gather {
+    fn behind(&self, b: &Branch, (hit, shape): (&Hit, &Shape), trail: &Trail<DEPTH>) -> Gather {
         if !self.store.reaches(hit.point) {
             return Gather::Dark;
         }
@@ -454,6 +454,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             b,
             throughput,
             direct,
+            curvature: shape.curvature(hit.normal),
         })
     }
 
@@ -488,9 +489,10 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             trail.record(b.depth, (d, b.bend), hit, index, eta);
         };
         match &object.material {
-            Material::Diffuse(m) if front => {
-                (self.diffuse(b, hit, m, trail, count, log), [None, None])
-            }
+            Material::Diffuse(m) if front => (
+                self.diffuse(b, (hit, &object.shape), m, trail, count, log),
+                [None, None],
+            ),
             Material::Diffuse(_) => (Rgb::ZERO, [None, None]),
             Material::Mirror(m) if can_bounce => {
                 let w = b.weight * m.reflectance;
@@ -520,7 +522,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
             Material::Classic(c) => {
                 let local = if front {
-                    self.classic_local(b, hit, c, trail, count, log)
+                    self.classic_local(b, (hit, &object.shape), c, trail, count, log)
                 } else {
                     Rgb::ZERO
                 };
@@ -559,13 +561,13 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     fn diffuse(
         &self,
         b: &Branch,
-        hit: &Hit,
+        (hit, shape): (&Hit, &Shape),
         m: &crate::material::Diffuse,
         trail: &Trail<DEPTH>,
         count: &mut RayCount,
         log: &mut Sample,
     ) -> Rgb {
-        let caustic = match self.gather(b, hit, trail) {
+        let caustic = match self.gather(b, (hit, shape), trail) {
             Gather::Footprint(f) => self.store.irradiance_within(hit.point, hit.normal, &f),
             Gather::Store => Halves::whole(self.store.irradiance(hit.point, hit.normal)),
             Gather::Splatted | Gather::Dark => Halves::default(),
@@ -595,7 +597,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     fn classic_local(
         &self,
         b: &Branch,
-        hit: &Hit,
+        (hit, shape): (&Hit, &Shape),
         c: &Classic,
         trail: &Trail<DEPTH>,
         count: &mut RayCount,
@@ -614,7 +616,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 lit += c.kernel(n, l, to_eye) * e;
             }
         }
-        let caustic = match self.gather(b, hit, trail) {
+        let caustic = match self.gather(b, (hit, shape), trail) {
             Gather::Footprint(f) => self.store.classic_within(hit.point, n, to_eye, c, &f),
             Gather::Store => Halves::whole(self.store.classic(hit.point, n, to_eye, c)),
             Gather::Splatted | Gather::Dark => Halves::default(),
