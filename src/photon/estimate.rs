@@ -816,9 +816,21 @@ mod tests {
         assert!(checked > 30_000 && passed > 300, "{checked} {passed}");
     }
 
-    /// The store of radius 1 over a [`field`]'s photons (power unit 1, `K` = 8).
+    /// The store of radius 1 over balanced `photons` (power unit 1, `K` = 8).
     fn store_of(photons: &[Photon]) -> KdStore<'_, 8> {
         KdStore::new(KdTree::from_balanced(photons), 1.0, None, 1.0, None)
+    }
+
+    /// The photons (both halves) that footprint `fp` about `x`, on a surface facing +y,
+    /// counts in one search within its visits.
+    fn counted(store: &KdStore<'_, 8>, x: Vec3, fp: &Footprint) -> u32 {
+        let region = Region::new(fp, store.max_radius2).unwrap();
+        let mut weight = |_: UnitVec3, p: Rgb| p;
+        let tree = Some(*store.tree());
+        let (_, visits, found) =
+            store.sum_in(tree, x, UnitVec3::Y, &region, false, Some(&mut weight));
+        assert!(visits.is_some());
+        found[0] + found[1]
     }
 
     /// A floor's footprint by a wall counts the floor's photons alone: the wall's, on
@@ -840,22 +852,11 @@ mod tests {
             photons.push(Photon::new(wall, down, Rgb::splat(1.0)).with_half(i % 2 == 0));
         }
         balance(&mut photons);
-        let tree = KdTree::from_balanced(&photons);
-        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         // A square of half-side 0.05 about a point 0.02 from the wall: it reaches
         // across the corner into the wall.
         let x = Vec3::new(0.0, 0.0, -0.02);
         let region = Region::new(&square(0.05), store.max_radius2).unwrap();
-        let mut weight = |_: UnitVec3, p: Rgb| p;
-        let (_, visits, found) = store.sum_in(
-            Some(tree),
-            x,
-            UnitVec3::Y,
-            &region,
-            false,
-            Some(&mut weight),
-        );
-        assert!(visits.is_some());
         // The floor's, and the wall's within rounding of the floor (a hundredth of the
         // reach and 10⁻⁴·0.02: the corner itself, a few photons).
         let (mut floor, mut wall) = (0u32, 0u32);
@@ -866,7 +867,7 @@ mod tests {
             floor += (within && q.y <= 0.01 * region.reach2.sqrt() + 2e-6) as u32;
             wall += (within && near && q.y > 0.0) as u32;
         }
-        assert_eq!(found[0] + found[1], floor);
+        assert_eq!(counted(&store, x, &square(0.05)), floor);
         assert!(
             wall > floor,
             "{wall} wall photons in reach, {floor} on the floor"
@@ -896,26 +897,14 @@ mod tests {
             })
             .collect();
         balance(&mut photons);
-        let tree = KdTree::from_balanced(&photons);
-        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None);
+        let store = store_of(&photons);
         let x = Vec3::new(0.0, radius, 0.0);
         let count = |half: f32, curvature: f32| {
             let fp = Footprint {
                 curvature,
                 ..square(half)
             };
-            let region = Region::new(&fp, store.max_radius2).unwrap();
-            let mut weight = |_: UnitVec3, p: Rgb| p;
-            let (_, visits, found) = store.sum_in(
-                Some(tree),
-                x,
-                UnitVec3::Y,
-                &region,
-                false,
-                Some(&mut weight),
-            );
-            assert!(visits.is_some());
-            found[0] + found[1]
+            counted(&store, x, &fp)
         };
         for half in [0.1, 0.3] {
             // The upper cap's photons whose projection lies in the square.
