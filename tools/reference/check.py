@@ -155,14 +155,45 @@ def compare_pair(A, B):
     return res
 
 
+def mean_of_seeds(runs):
+    """The mean of n renders (seeds) of one scene, full image and caustic part, and its
+    own noise: per pixel the seeds' sample variance (n - 1) over n, as relative RMSE
+    sqrt(mean var/n) / mean over the image and over the caustic region, per pixel and
+    over 2x2 bins. For two seeds each is the pair's relative RMSE / 2."""
+    n = len(runs)
+    full = np.stack([r["full"] for r in runs])
+    caustic = np.stack([r["caustic"] for r in runs])
+    mf, mc = full.mean(axis=0), caustic.mean(axis=0)
+    mask = caustic_mask(mc, mf)
+    m2 = binned(mask[..., None].astype(float), 2)[..., 0] > 0.5
+    bins = np.stack([binned(f, 2) for f in full])
+
+    def rel(stack, region):
+        var = stack.var(axis=0, ddof=1) / n
+        mean = stack.mean(axis=0)
+        if region is None:
+            return float(np.sqrt(var.mean()) / mean.mean())
+        return float(np.sqrt(var[region].mean()) / mean[region].mean())
+
+    noise = dict(seeds=n,
+                 mean_of_seeds_rel_rmse_full=rel(full, None),
+                 mean_of_seeds_rel_rmse_caustic_region=rel(full, mask),
+                 mean_of_seeds_rel_rmse_full_2x2=rel(bins, None),
+                 mean_of_seeds_rel_rmse_caustic_region_2x2=rel(bins, m2),
+                 mean_of_seeds_caustic_px=int(mask.sum()))
+    return mf, mc, noise
+
+
 def main(argv):
     ap = argparse.ArgumentParser(prog="run --check")
     ap.add_argument("--width", type=int, default=160)
     ap.add_argument("--height", type=int, default=120)
-    ap.add_argument("--pair", nargs=2, metavar="PREFIX", help="noise between two renders (seeds) of one scene")
-    ap.add_argument("--json", help="with --pair: write the noise figures and both runs' statistics (PREFIX.json) here")
+    ap.add_argument("--pair", nargs="+", metavar="PREFIX",
+                    help="noise between renders (seeds) of one scene: two or more; the pair "
+                         "figures are of the first two, the mean's noise of all")
+    ap.add_argument("--json", help="with --pair: write the noise figures and the runs' statistics (PREFIX.json) here")
     ap.add_argument("--mean-to", metavar="PREFIX",
-                    help="with --pair: write the mean of the two seeds as PREFIX.pfm and PREFIX.caustic.pfm")
+                    help="with --pair: write the mean of the seeds as PREFIX.pfm and PREFIX.caustic.pfm")
     ap.add_argument("--skip-analytic", action="store_true")
     args = ap.parse_args(argv)
     W, H = args.width, args.height
@@ -175,16 +206,17 @@ def main(argv):
             tag = "(max)" if name == "floor only" else "(median)"
             print(f"  {name:<24} {e:>10.2e} {nbad:>9d} {n:>6d} {mc:>12.1e}   rel err {tag}")
     if args.pair:
-        A, B = load_prefix(args.pair[0]), load_prefix(args.pair[1])
-        res = compare_pair(A, B)
+        if len(args.pair) < 2:
+            ap.error("--pair: at least two renders")
+        runs = [load_prefix(p) for p in args.pair]
+        res = compare_pair(runs[0], runs[1])
+        mean = mean_of_seeds(runs)
+        res.update(mean[2])
         print(json.dumps(res, indent=1))
         if args.mean_to:
-            H, W = A["full"].shape[:2]
-            for suffix, k in (("", "full"), (".caustic", "caustic")):
-                R.write_pfm(f"{args.mean_to}{suffix}.pfm", (0.5 * (A[k] + B[k])).reshape(-1, 3), W, H)
-            # the mean of two independent renders has rel. RMSE pair / 2 (variance sigma^2 / 2)
-            res["mean_of_seeds_rel_rmse_full"] = res["pair_rel_rmse_full"] / 2
-            res["mean_of_seeds_rel_rmse_caustic_region"] = res["pair_rel_rmse_caustic_region"] / 2
+            H, W = runs[0]["full"].shape[:2]
+            for suffix, m in (("", mean[0]), (".caustic", mean[1])):
+                R.write_pfm(f"{args.mean_to}{suffix}.pfm", m.reshape(-1, 3), W, H)
         if args.json:
             runs = []
             for p in args.pair:
