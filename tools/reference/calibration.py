@@ -91,7 +91,7 @@ def reference(name, width):
     if b == 1:
         ref_noise = (noise["mean_of_seeds_rel_rmse_full"], noise["mean_of_seeds_rel_rmse_caustic_region"])
     elif b == 2:
-        ref_noise = (noise["pair_rel_rmse_full_2x2"] / 2, noise["pair_rel_rmse_caustic_region_2x2"] / 2)
+        ref_noise = (noise["mean_of_seeds_rel_rmse_full_2x2"], noise["mean_of_seeds_rel_rmse_caustic_region_2x2"])
     else:
         raise SystemExit("calibration: the reference noise is known at 1x1 and 2x2 bins only")
     return full, region, ref_noise
