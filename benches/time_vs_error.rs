@@ -11,8 +11,8 @@
 //! caustic region (the reference's caustic part at least 10% of its luminance, Rec. 709:
 //! the README's definition). It writes `target/time_vs_error/time_vs_error.csv` and a
 //! log–log plot of the caustic region's error against time, one panel per scene, with
-//! the reference's own noise there (`NAME.ref.json`: the committed mean of two seeds has
-//! half their difference) as a dashed floor: `time_vs_error.svg`.
+//! the reference's own noise there (`NAME.ref.json`: the committed mean's, from its
+//! seeds' spread) as a dashed floor: `time_vs_error.svg`.
 //!
 //! `CAUSTIC_BENCH_QUICK=1` runs a reduced sweep (one repeat, fewer budgets);
 //! `CAUSTIC_BENCH_OUT=DIR` moves the output.
