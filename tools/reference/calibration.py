@@ -9,8 +9,8 @@ factor-2 band).
 
 Measured error: relative RMSE sqrt(mean((a-b)^2))/mean(b) over pixels and channels, of the
 full image and of the caustic region (reference caustic part >= 10 % of the reference
-luminance, Rec. 709). The reference has noise of its own (NAME.ref.json: the committed mean of
-two seeds has half the seed pair's rel. RMSE); the render and the reference are independent,
+luminance, Rec. 709). The reference has noise of its own (NAME.ref.json: that of the committed
+mean of its seeds, from their spread); the render and the reference are independent,
 so E[measured^2] = true^2 + ref_noise^2, and the column `true` is sqrt(max(measured^2 -
 ref_noise^2, 0)). The ratio estimated / true is what must lie within a factor 2.
 
