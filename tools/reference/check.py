@@ -208,14 +208,14 @@ def main(argv):
     if args.pair:
         if len(args.pair) < 2:
             ap.error("--pair: at least two renders")
-        runs = [load_prefix(p) for p in args.pair]
-        res = compare_pair(runs[0], runs[1])
-        mean = mean_of_seeds(runs)
-        res.update(mean[2])
+        renders = [load_prefix(p) for p in args.pair]
+        res = compare_pair(renders[0], renders[1])
+        mean_full, mean_caustic, noise = mean_of_seeds(renders)
+        res.update(noise)
         print(json.dumps(res, indent=1))
         if args.mean_to:
-            H, W = runs[0]["full"].shape[:2]
-            for suffix, m in (("", mean[0]), (".caustic", mean[1])):
+            H, W = mean_full.shape[:2]
+            for suffix, m in (("", mean_full), (".caustic", mean_caustic)):
                 R.write_pfm(f"{args.mean_to}{suffix}.pfm", m.reshape(-1, 3), W, H)
         if args.json:
             runs = []
