@@ -844,6 +844,33 @@ fn a_sliver_between_the_grids_rows_is_sampled() {
     );
 }
 
+/// A grazing pixel whose first grid's halves agree: pixel (177, 73) of the sphere +
+/// wall c (320×240, 20k photons) sees the focus through the sphere's upper rim, where
+/// its samples graze the glass. Its first grid costs too many rays for the jump to the
+/// 16×16 grid, and both checkerboard halves of that 4×4 grid alias the focus alike, so
+/// they agree: trusted, the pixel stopped there, 6% below a 32×32 grid. It now refines
+/// at least once whatever its halves say, and reads the 32×32 grid's value within 1%.
+#[test]
+fn a_grazing_pixel_refines_past_a_first_grid_whose_halves_agree() {
+    let [grid4, adaptive, grid32] = pixel_under(
+        "heldout/more/sphere_wall_c.json",
+        (177, 73),
+        [
+            Sampling::Grid(4),
+            Sampling::Adaptive(REFINE),
+            Sampling::Grid(32),
+        ],
+    );
+    assert!(
+        (grid4 - grid32).abs() > 0.04 * grid32,
+        "the 4×4 grid is already right: {grid4} {grid32}"
+    );
+    assert!(
+        (adaptive - grid32).abs() < 0.01 * grid32,
+        "adaptive {adaptive}, 32×32 {grid32}, 4×4 {grid4}"
+    );
+}
+
 /// The focus seen through a ball's rim: pixel (143, 148) of the sphere + wall (320×240,
 /// 20k photons) looks through the sphere's lower rim at grazing incidence onto the
 /// focus under it. Of its eye-sampled part, a 16×16 grid — where the grazing rule used
