@@ -817,6 +817,36 @@ fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f
     })
 }
 
+/// Pixel `px` of scene `name` ([`pixel_under`]) on an `n × n` grid, under the adaptive
+/// sampling and on a `fine × fine` grid (`[n, fine]`): asserts that the coarse grid is
+/// off the fine one by more than `off` of its value and the adaptive sampling within
+/// `within` of it (`[off, within]`); returns the coarse and fine values.
+fn adaptive_reaches_the_fine_grid(
+    name: &str,
+    px: (usize, u32),
+    [n, fine]: [u32; 2],
+    [off, within]: [f32; 2],
+) -> (f32, f32) {
+    let [coarse, adaptive, exact] = pixel_under(
+        name,
+        px,
+        [
+            Sampling::Grid(n),
+            Sampling::Adaptive(REFINE),
+            Sampling::Grid(fine),
+        ],
+    );
+    assert!(
+        (coarse - exact).abs() > off * exact,
+        "the {n}×{n} grid is already right: {coarse} {exact}"
+    );
+    assert!(
+        (adaptive - exact).abs() < within * exact,
+        "adaptive {adaptive}, {fine}×{fine} {exact}, {n}×{n} {coarse}"
+    );
+    (coarse, exact)
+}
+
 /// A sliver between the grid's rows: pixel (172, 72) of the sphere + wall c (320×240)
 /// has the wall at its top corners and the sphere's rim at its bottom ones, and through
 /// the last eighth of the pixel's height the rim shows a focus. Every sample of a 4×4
@@ -825,22 +855,15 @@ fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f
 /// 32×32 one within 5% (the reference's own average: 0.36, the wall alone 0.21).
 #[test]
 fn a_sliver_between_the_grids_rows_is_sampled() {
-    let [grid4, adaptive, grid32] = pixel_under(
+    let (grid4, grid32) = adaptive_reaches_the_fine_grid(
         "heldout/more/sphere_wall_c.json",
         (172, 72),
-        [
-            Sampling::Grid(4),
-            Sampling::Adaptive(REFINE),
-            Sampling::Grid(32),
-        ],
+        [4, 32],
+        [0.2, 0.05],
     );
     assert!(
-        grid4 < 0.8 * grid32,
+        grid4 < grid32,
         "the 4×4 grid sees the focus: {grid4} {grid32}"
-    );
-    assert!(
-        (adaptive - grid32).abs() < 0.05 * grid32,
-        "adaptive {adaptive}, 32×32 {grid32}, 4×4 {grid4}"
     );
 }
 
@@ -852,22 +875,11 @@ fn a_sliver_between_the_grids_rows_is_sampled() {
 /// at least once whatever its halves say, and reads the 32×32 grid's value within 1%.
 #[test]
 fn a_grazing_pixel_refines_past_a_first_grid_whose_halves_agree() {
-    let [grid4, adaptive, grid32] = pixel_under(
+    adaptive_reaches_the_fine_grid(
         "heldout/more/sphere_wall_c.json",
         (177, 73),
-        [
-            Sampling::Grid(4),
-            Sampling::Adaptive(REFINE),
-            Sampling::Grid(32),
-        ],
-    );
-    assert!(
-        (grid4 - grid32).abs() > 0.04 * grid32,
-        "the 4×4 grid is already right: {grid4} {grid32}"
-    );
-    assert!(
-        (adaptive - grid32).abs() < 0.01 * grid32,
-        "adaptive {adaptive}, 32×32 {grid32}, 4×4 {grid4}"
+        [4, 32],
+        [0.04, 0.01],
     );
 }
 
@@ -878,21 +890,10 @@ fn a_grazing_pixel_refines_past_a_first_grid_whose_halves_agree() {
 /// sampling refines on to 32×32 and agrees with the 64×64 grid within 1.5% (0.0277).
 #[test]
 fn a_focus_seen_through_a_rim_refines_past_the_16x16_grid() {
-    let [grid16, adaptive, grid64] = pixel_under(
+    adaptive_reaches_the_fine_grid(
         "heldout/sphere_wall.json",
         (143, 148),
-        [
-            Sampling::Grid(16),
-            Sampling::Adaptive(REFINE),
-            Sampling::Grid(64),
-        ],
-    );
-    assert!(
-        (grid16 - grid64).abs() > 0.05 * grid64,
-        "the 16×16 grid is already right: {grid16} {grid64}"
-    );
-    assert!(
-        (adaptive - grid64).abs() < 0.015 * grid64,
-        "adaptive {adaptive}, 64×64 {grid64}, 16×16 {grid16}"
+        [16, 64],
+        [0.05, 0.015],
     );
 }
