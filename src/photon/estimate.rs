@@ -407,10 +407,12 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         let last = |r: &Region, found: [u32; 2]| {
             found[0] + found[1] >= 2 * SPARSE_FOOTPRINT || r.reach2 * 4.0 > self.max_radius2
         };
+        // Half h is placed on a patch where the other half holds this many photons.
+        let places = |found: [u32; 2], h: usize| found[1 - h] >= SPARSE_FOOTPRINT / 2;
         for _ in 0..W + first.is_none() as u32 {
             if let Some((r, sum, found)) = kept {
                 for h in 0..2 {
-                    if !placed[h] && found[1 - h] >= SPARSE_FOOTPRINT / 2 {
+                    if !placed[h] && places(found, h) {
                         (density[h], placed[h]) = (sum[h] * (1.0 / r.area), true);
                     }
                 }
@@ -432,9 +434,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         }
         if self.reads_direct() && W == 1 && direct >= MAGNIFIED * region.area {
             // Where the loop above, given more widenings, would go on: past the first,
-            // not its last, a half whose other half holds too few photons there.
+            // not its last, a half its last patch would not place.
             if let (Some(first), Some((r, _, found))) = (first, kept) {
-                let waiting = (0..2).any(|h| !placed[h] && found[1 - h] < SPARSE_FOOTPRINT / 2);
+                let waiting = (0..2).any(|h| !placed[h] && !places(found, h));
                 if r.area > region.area && waiting && !last(&r, found) {
                     return self.widened_far(x, n, region, first, weight);
                 }
