@@ -908,3 +908,14 @@ fn a_focus_seen_through_a_rim_refines_past_the_16x16_grid() {
 fn a_grazing_pixel_refines_until_two_grids_agree() {
     adaptive_reaches_the_fine_grid("glass_sphere.json", (172, 145), [8, 32], [0.05, 0.01]);
 }
+
+/// A corner brighter than every sample: pixel (221, 150) of the two balls (320×240,
+/// 20k photons) has at its top-right corner a focus seen through a ball, 24 times the
+/// brightness of the rest of the pixel, and no sample of its 4×4 grid sees it. The
+/// grid's halves agree, so the pixel stopped there at half its value; a corner outside
+/// the range of the grid's samples now counts as the error of the half sub-pixel
+/// around it, and the pixel goes on to finer grids.
+#[test]
+fn a_corner_no_sample_matches_refines_the_pixel() {
+    adaptive_reaches_the_fine_grid("two_balls.json", (221, 150), [4, 32], [0.4, 0.05]);
+}
