@@ -279,24 +279,23 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let start = count.eye + count.shadow;
         let cap = REFINE_RAYS as u64 * self.ray_budget as u64;
         let first = self.grid(x, y, n, count);
-        let (mut p, mut photons, mut range) = (first.pixel, first.photons, first.range);
         let mut last = count.eye + count.shadow - start;
         // Both constant false on a device's store: not compiled there.
-        let missed = self.store.reads_direct() && edge && first.uniform;
-        let deep = self.store.reads_direct() && first.grazing;
-        let (mut m, top) = if (first.grazing || missed) && 16 * last <= cap {
+        let desktop = self.store.reads_direct();
+        let missed = desktop && edge && first.uniform;
+        let deep = desktop && first.grazing;
+        let (mut g, mut m, top) = if (first.grazing || missed) && 16 * last <= cap {
             let before = count.eye + count.shadow;
             let finest = self.grid(x, y, 4 * n, count);
             if !deep {
                 return finest.pixel;
             }
-            (p, photons, range) = (finest.pixel, finest.photons, finest.range);
             last = count.eye + count.shadow - before;
-            (4 * n, 8 * n)
+            (finest, 4 * n, 8 * n)
         } else if deep {
-            (n, 8 * n)
+            (first, n, 8 * n)
         } else {
-            (n, 4 * n)
+            (first, n, 4 * n)
         };
         let cap = if deep {
             GRAZING_RAYS as u64 * self.ray_budget as u64
@@ -306,24 +305,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         // A grazing pixel's grid before the last one doubled, once there is one.
         let mut coarser: Option<f32> = None;
         while m < top && m <= 32 {
-            let mut e = p.sampling2.luminance() - photons;
-            if self.store.reads_direct() {
-                // A corner brighter or darker than every sample: what it saw may lie
-                // within half a sub-pixel of it, unsampled.
-                let w = 1.0 / (4 * m * m) as f32;
-                for l in corners {
-                    let d = (l - crate::math::clamp(l, range.0, range.1)) * w;
-                    e = crate::math::max(e, d * d);
-                }
-            }
-            if let Some(c) = coarser {
-                // Halves that alias a sliver alike can agree on a wrong value twice in
-                // a row; two grids of different sides rarely do. Half their difference
-                // bounds what the finer one is still off by.
-                let d = (p.radiance.luminance() - c) * 0.5;
-                e = crate::math::max(e, d * d);
-            }
-            let scale = crate::math::max(p.radiance.luminance(), bright) * REFINE_TOLERANCE;
+            let e = g.error2(m, desktop.then_some(corners), coarser);
+            let value = g.pixel.radiance.luminance();
+            let scale = crate::math::max(value, bright) * REFINE_TOLERANCE;
             let spent = count.eye + count.shadow - start;
             // A grazing pixel's first grid, when the jump was too costly, refines once
             // whatever its halves say: they alias the sliver together.
@@ -332,15 +316,14 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 break;
             }
             if deep {
-                coarser = Some(p.radiance.luminance());
+                coarser = Some(value);
             }
             m *= 2;
             let before = count.eye + count.shadow;
-            let next = self.grid(x, y, m, count);
-            (p, photons, range) = (next.pixel, next.photons, next.range);
+            g = self.grid(x, y, m, count);
             last = count.eye + count.shadow - before;
         }
-        p
+        g.pixel
     }
 
     /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
@@ -525,6 +508,30 @@ struct Grid {
     uniform: bool,
     /// The least and the greatest luminance of its samples.
     range: (f32, f32),
+}
+
+impl Grid {
+    /// The squared error of the luminance of this `m × m` grid's pixel, as its
+    /// refinement judges it: the checkerboard halves' estimate less what the photons
+    /// of samples widened far explain; on the desktop (`corners`: the pixel's corner
+    /// luminances) at least each corner's distance from the samples' range times the
+    /// half sub-pixel around it, `1/(4m²)` of the pixel — what it saw may lie there,
+    /// unsampled; and with the `coarser` grid's luminance before it (a grazing pixel)
+    /// at least half their difference — halves that alias a sliver alike can agree on a
+    /// wrong value twice in a row, two grids of different sides rarely do.
+    fn error2(&self, m: u32, corners: Option<[f32; 4]>, coarser: Option<f32>) -> f32 {
+        let mut e = self.pixel.sampling2.luminance() - self.photons;
+        let w = 1.0 / (4 * m * m) as f32;
+        for l in corners.into_iter().flatten() {
+            let d = (l - crate::math::clamp(l, self.range.0, self.range.1)) * w;
+            e = crate::math::max(e, d * d);
+        }
+        if let Some(c) = coarser {
+            let d = (self.pixel.radiance.luminance() - c) * 0.5;
+            e = crate::math::max(e, d * d);
+        }
+        e
+    }
 }
 
 /// A pixel of one sample.
