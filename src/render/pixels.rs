@@ -7,7 +7,10 @@
 //! `(max − min)/(max + min)` above [`CONTRAST`], Mitchell 1987), average an `n × n`
 //! grid of sub-pixel rays instead. Corners are shared along a row, so a smooth region
 //! costs about two rays a pixel; shadow edges, silhouettes and whatever is seen through
-//! glass get `n²`.
+//! glass get `n²`. A grid is refined to `2n` and `4n` while its error estimate
+//! ([`Grid::error2`]: the checkerboard halves' difference, a corner no sample matches,
+//! two grids in a row that disagree) exceeds [`REFINE_TOLERANCE`] of the pixel's
+//! brightness, within a ray budget per pixel.
 
 use super::{PixelEstimate, RayCount, Renderer, RowsError, Sample};
 use crate::error::Error;
