@@ -561,3 +561,46 @@ fn contrasted(c: &[Sample; 4]) -> bool {
     // `!(a ≤ b)` so that NaN always counts as contrast.
     !(hi - lo <= CONTRAST * (hi + lo))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4×4 grid of grey samples reading 1 to 2, halves that differ by `halves`.
+    fn grid(halves: f32) -> Grid {
+        Grid {
+            pixel: PixelEstimate {
+                radiance: Rgb::splat(1.5),
+                sampling2: Rgb::splat(halves * halves),
+                ..PixelEstimate::default()
+            },
+            photons: 0.0,
+            grazing: false,
+            uniform: false,
+            range: (1.0, 2.0),
+        }
+    }
+
+    /// Each term of the refinement's error estimate is the one its reason gives, and
+    /// the estimate is the largest: the halves alone; a corner inside the samples'
+    /// range adds nothing; one outside counts its distance from the range times the
+    /// `1/(4m²)` of the pixel around it; two grids in a row half their difference.
+    #[test]
+    fn the_error_estimate_is_the_largest_of_its_reasons() {
+        let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * b.abs().max(1e-12);
+        let g = grid(0.01);
+        assert!(close(g.error2(4, None, None), 1e-4));
+        assert!(close(g.error2(4, Some([1.0, 1.2, 2.0, 1.7]), None), 1e-4));
+        // A corner at 10, 8 above the range: (8/64)² on a 4×4 grid, (8/256)² on 8×8.
+        let corners = Some([10.0, 1.5, 1.5, 0.5]);
+        assert!(close(g.error2(4, corners, None), 0.125 * 0.125));
+        assert!(close(g.error2(8, corners, None), 0.03125 * 0.03125));
+        // Below the range counts the same way: 0.5 under it gives (0.5/64)², under the
+        // halves' 10⁻⁴. A coarser grid at 1.1 against this one's 1.5 gives (0.4/2)².
+        assert!(close(g.error2(4, Some([0.5; 4]), None), 1e-4));
+        assert!(close(g.error2(4, None, Some(1.1)), 0.04));
+        // The largest wins whichever comes first.
+        assert!(close(g.error2(4, corners, Some(1.1)), 0.04));
+        assert!(close(grid(0.5).error2(4, corners, Some(1.1)), 0.25));
+    }
+}
