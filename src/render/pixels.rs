@@ -8,8 +8,8 @@
 //! grid of sub-pixel rays instead. Corners are shared along a row, so a smooth region
 //! costs about two rays a pixel; shadow edges, silhouettes and whatever is seen through
 //! glass get `n²`. A grid is refined to `2n` and `4n` while its error estimate
-//! ([`Grid::error2`]: the checkerboard halves' difference, a corner no sample matches,
-//! two grids in a row that disagree) exceeds [`REFINE_TOLERANCE`] of the pixel's
+//! ([`Grid::error2`]: the checkerboard halves' difference, a corner outside the range
+//! of the grid's samples, two grids in a row that disagree) exceeds [`REFINE_TOLERANCE`] of the pixel's
 //! brightness, within a ray budget per pixel.
 
 use super::{PixelEstimate, RayCount, Renderer, RowsError, Sample};
@@ -138,7 +138,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         // The signature every sample shares, if they all do.
         let mut shared = None;
         let mut uniform = true;
-        let mut range = (f32::INFINITY, 0.0f32);
+        let mut range = NO_RANGE;
         for sy in 0..n {
             for sx in 0..n {
                 let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
@@ -148,11 +148,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     grazing = crate::math::max(grazing, s.caustic.luminance());
                 }
                 uniform &= *shared.get_or_insert(s.signature) == s.signature;
-                let l = s.radiance.luminance();
-                range = (
-                    crate::math::min_num(range.0, l),
-                    crate::math::max(range.1, l),
-                );
+                range = widen(range, s.radiance.luminance());
                 let k = ((sx + sy) & 1) as usize;
                 // Constant false on a device's store: not compiled there.
                 if self.store.reads_direct() && count.widened > before {
@@ -547,17 +543,22 @@ fn one(s: &Sample) -> PixelEstimate {
     }
 }
 
+/// The range of luminances before any: [`widen`] by the first gives `(l, max(0, l))`.
+const NO_RANGE: (f32, f32) = (f32::INFINITY, 0.0);
+
+/// The range of luminances `(lo, hi)` with `l` in it too. A NaN `l` leaves `lo` as it
+/// is and makes `hi` NaN (corners with one count as contrasted).
+#[inline]
+fn widen((lo, hi): (f32, f32), l: f32) -> (f32, f32) {
+    (crate::math::min_num(lo, l), crate::math::max(hi, l))
+}
+
 /// `true` when the luminances of four corner samples differ by more than [`CONTRAST`]
 /// (Mitchell 1987's contrast) or one is NaN.
 fn contrasted(c: &[Sample; 4]) -> bool {
-    let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
-    for x in c {
-        let l = x.radiance.luminance();
-        if l < lo {
-            lo = l;
-        }
-        hi = crate::math::max(hi, l);
-    }
+    let (lo, hi) = c
+        .iter()
+        .fold(NO_RANGE, |r, s| widen(r, s.radiance.luminance()));
     // `!(a ≤ b)` so that NaN always counts as contrast.
     !(hi - lo <= CONTRAST * (hi + lo))
 }
