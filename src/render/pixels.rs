@@ -208,12 +208,12 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Seen through a ball's rim such a sliver can hold a focus: the sphere + wall c's
     /// pixel (172, 72) read 0.21 on a 4×4 grid, 0.35 on a 16×16 one and 32×32, 0.36 in
     /// its reference. Such pixels went straight to `4n × 4n` before; through `2n × 2n`
-    /// the tuning scenes' caustic regions (1.6M, four seeds) read the same to 0.0019 of
-    /// their values (glass sphere, two balls, tube, lens wall) for 3.5–13% fewer eye
-    /// rays. Held out, measured afterwards: the sphere + wall and the balls scene the
-    /// same or up to 0.0002 better for 11% and 6% fewer eye rays (the balls scene's wall
-    /// time 0.973 of before, paired over 9 runs), the tilted cube 0.0001 worse in both
-    /// its regions for 19% fewer.
+    /// the tuning scenes' caustic regions (1.6M, four seeds) read the same within
+    /// 0.0001 (glass sphere, two balls, tube; the lens wall's up to 0.0019 lower) for
+    /// 3.5–13% fewer eye rays. Held out, measured afterwards: the sphere + wall and the
+    /// balls scene the same or up to 0.0002 better for 11% and 6% fewer eye rays (the
+    /// balls scene's wall time 0.973 of before, paired over 9 runs), the tilted cube
+    /// 0.0001 worse in both its regions for 19% fewer.
     ///
     /// On the desktop such a grazing pixel then refines on to `8n × 8n` while the error
     /// estimate asks for it, within [`GRAZING_RAYS`] budgets — from its first grid where
