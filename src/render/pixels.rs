@@ -9,8 +9,8 @@
 //! costs about two rays a pixel; shadow edges, silhouettes and whatever is seen through
 //! glass get `n²`. A grid is refined to `2n` and `4n` while its error estimate
 //! ([`Grid::error2`]: the checkerboard halves' difference, a corner outside the range
-//! of the grid's samples, two grids in a row that disagree) exceeds [`REFINE_TOLERANCE`] of the pixel's
-//! brightness, within a ray budget per pixel.
+//! of the grid's samples, two grids in a row that disagree) exceeds
+//! [`REFINE_TOLERANCE`] of the pixel's brightness, within a ray budget per pixel.
 
 use super::{PixelEstimate, RayCount, Renderer, RowsError, Sample};
 use crate::error::Error;
@@ -196,9 +196,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Pixel `(x, y)` on an `n × n` grid, then `2n × 2n` and `4n × 4n` while the
     /// grid's error estimate exceeds [`REFINE_TOLERANCE`] of the brighter of the
     /// pixel's value and its brightest corner (luminances `corners`; a focus seen
-    /// through glass needs hundreds of rays),
-    /// and while the next grid — four times the rays of the last — keeps the pixel
-    /// within [`REFINE_RAYS`] times the ray budget of one camera ray.
+    /// through glass needs hundreds of rays), and while the next grid — four times the
+    /// rays of the last — keeps the pixel within [`REFINE_RAYS`] times the ray budget
+    /// of one camera ray.
     ///
     /// Straight to the `4n × 4n` grid, within that budget, where a sample grazed glass
     /// ([`GRAZING`]). On the desktop, where the corners saw different things along their
@@ -244,10 +244,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// between the last grid and the one before it. At 1.6M photons the glass sphere's
     /// rim pixel (172, 145) stopped on an 8×8 grid whose halves agreed, at 1.79, 11%
     /// under its reference (2.00); it now goes on to 16×16 (1.91). At 1.6M and four
-    /// seeds, for under 1% more eye rays: the glass
-    /// sphere's caustic region 0.0247 0.0201 0.0269 0.0225 → 0.0207 0.0198 0.0269
-    /// 0.0196, the two balls' 0.0287 0.0394 0.0334 0.0310 → 0.0286 0.0329 0.0313
-    /// 0.0311, the tube and the lens wall the same (tuning); held out, measured
+    /// seeds, for under 1% more eye rays: the glass sphere's caustic region 0.0247
+    /// 0.0201 0.0269 0.0225 → 0.0207 0.0198 0.0269 0.0196, the two balls' 0.0287 0.0394
+    /// 0.0334 0.0310 → 0.0286 0.0329 0.0313 0.0311, the tube and the lens wall the same (tuning); held out, measured
     /// afterwards, the sphere + wall, the balls scene and the sphere + wall c the same
     /// or up to 0.001 better, the tilted cube the same bits.
     ///
@@ -285,24 +284,21 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let bright = corners.into_iter().fold(0.0, f32::max);
         let start = count.eye + count.shadow;
         let cap = REFINE_RAYS as u64 * self.ray_budget as u64;
-        let first = self.grid(x, y, n, count);
-        let mut last = count.eye + count.shadow - start;
+        let (first, mut last) = self.costed_grid(x, y, n, count);
         // Both constant false on a device's store: not compiled there.
         let desktop = self.store.reads_direct();
         let missed = desktop && edge && first.uniform;
         let deep = desktop && first.grazing;
         let (mut g, mut m, top) = if deep && 16 * last <= cap {
-            let before = count.eye + count.shadow;
-            let finest = self.grid(x, y, 4 * n, count);
-            last = count.eye + count.shadow - before;
+            let (finest, cost) = self.costed_grid(x, y, 4 * n, count);
+            last = cost;
             (finest, 4 * n, 8 * n)
-        } else if missed && !deep && 4 * last <= cap {
-            let before = count.eye + count.shadow;
-            let finer = self.grid(x, y, 2 * n, count);
-            last = count.eye + count.shadow - before;
-            (finer, 2 * n, 4 * n)
         } else if deep {
             (first, n, 8 * n)
+        } else if missed && 4 * last <= cap {
+            let (finer, cost) = self.costed_grid(x, y, 2 * n, count);
+            last = cost;
+            (finer, 2 * n, 4 * n)
         } else {
             (first, n, 4 * n)
         };
@@ -328,11 +324,16 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 coarser = Some(value);
             }
             m *= 2;
-            let before = count.eye + count.shadow;
-            g = self.grid(x, y, m, count);
-            last = count.eye + count.shadow - before;
+            (g, last) = self.costed_grid(x, y, m, count);
         }
         g.pixel
+    }
+
+    /// [`grid`](Self::grid), with the rays (eye and shadow) it cost.
+    fn costed_grid(&self, x: u32, y: u32, n: u32, count: &mut RayCount) -> (Grid, u64) {
+        let before = count.eye + count.shadow;
+        let g = self.grid(x, y, n, count);
+        (g, count.eye + count.shadow - before)
     }
 
     /// The sample at image corner `(cx, cy)`, `0 ≤ cx ≤ W`, `0 ≤ cy ≤ H`.
