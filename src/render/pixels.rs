@@ -53,14 +53,14 @@ pub const REFINE_TOLERANCE: f32 = 0.01;
 /// incidence. There the refracted direction turns fastest across the sub-pixel, so its
 /// differentials' linear footprint can lie far from the sub-pixel's true preimage; a
 /// 4×4 grid's sample that grazes the glass and gathers more than the whole pixel's
-/// value (the focus seen through the rim of a ball) sends the pixel straight to the
-/// finest grid, 16×16, whose sub-pixels are small enough for the linearisation. Chosen
-/// on the tuning scenes at 1.6M photons (four seeds): the glass sphere's caustic
-/// region 0.0260 → 0.0249 for 1.3% more eye rays, the two balls and the tube the same
-/// (+0.5%, 0%); below 0.3 the tube's eye rays grew 32% for nothing, and an 8×8 grid
-/// made the glass sphere's 0.0266. Held out, measured afterwards: the sphere + wall
-/// 0.0570 → 0.0547 (four seeds), the balls scene 0.0233 → 0.0226 (two seeds) for 1.1%
-/// more eye rays, the tilted cube the same.
+/// value (the focus seen through the rim of a ball) sends the pixel straight to a
+/// 16×16 grid, whose sub-pixels are small enough for the linearisation (and on, see
+/// `Renderer::refine`). Chosen on the tuning scenes at 1.6M photons (four seeds): the
+/// glass sphere's caustic region 0.0260 → 0.0249 for 1.3% more eye rays, the two balls
+/// and the tube the same (+0.5%, 0%); below 0.3 the tube's eye rays grew 32% for
+/// nothing, and an 8×8 grid made the glass sphere's 0.0266. Held out, measured
+/// afterwards: the sphere + wall 0.0570 → 0.0547 (four seeds), the balls scene 0.0233
+/// → 0.0226 (two seeds) for 1.1% more eye rays, the tilted cube the same.
 pub const GRAZING: f32 = 0.15;
 
 /// A pixel's further refinement stops before it would spend more than this many times
@@ -194,85 +194,38 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// Pixel `(x, y)` on an `n × n` grid, then `2n × 2n` and `4n × 4n` while the
-    /// grid's error estimate exceeds [`REFINE_TOLERANCE`] of the brighter of the
-    /// pixel's value and its brightest corner (luminances `corners`; a focus seen
-    /// through glass needs hundreds of rays), and while the next grid — four times the
-    /// rays of the last — keeps the pixel within [`REFINE_RAYS`] times the ray budget
-    /// of one camera ray.
+    /// grid's error estimate ([`Grid::error2`]) exceeds [`REFINE_TOLERANCE`] of the
+    /// brighter of the pixel's value and its brightest corner (luminances `corners`),
+    /// and while the next grid — four times the rays of the last — keeps the pixel
+    /// within [`REFINE_RAYS`] times the ray budget of one camera ray. The rules below
+    /// are the desktop's (a device's store compiles them away); each was chosen on the
+    /// tuning scenes and measured afterwards on the held-out ones (`docs/accuracy.md`
+    /// has the figures, from "The sphere + wall's remaining error" on).
     ///
-    /// Straight to the `4n × 4n` grid, within that budget, where a sample grazed glass
-    /// ([`GRAZING`]). On the desktop, where the corners saw different things along their
-    /// paths (an `edge`) but every sample of the first grid saw the same, the other side
-    /// is a sliver between the grid's rows: the pixel goes on to the `2n × 2n` grid,
-    /// whose rows lie between the first's, and from there as its error estimate asks.
-    /// Seen through a ball's rim such a sliver can hold a focus: the sphere + wall c's
-    /// pixel (172, 72) read 0.21 on a 4×4 grid, 0.35 on a 16×16 one and 32×32, 0.36 in
-    /// its reference. Such pixels went straight to `4n × 4n` before; through `2n × 2n`
-    /// the tuning scenes' caustic regions (1.6M, four seeds) read the same within
-    /// 0.0001 (glass sphere, two balls, tube; the lens wall's up to 0.0019 lower) for
-    /// 3.5–13% fewer eye rays. Held out, measured afterwards: the sphere + wall and the
-    /// balls scene the same or up to 0.0002 better for 11% and 6% fewer eye rays (the
-    /// balls scene's wall time 0.973 of before, paired over 9 runs), the tilted cube
-    /// 0.0001 worse in both its regions for 19% fewer.
-    ///
-    /// On the desktop such a grazing pixel then refines on to `8n × 8n` while the error
-    /// estimate asks for it, within [`GRAZING_RAYS`] budgets — from its first grid where
-    /// that was too costly for the jump: seen through a rim a 16×16 grid is still too
-    /// coarse. Chosen on the tuning scenes (four seeds): at 1.6M and 320×240 the two
-    /// balls' caustic region 0.0351 → 0.0314 for 1.8% more rays (most of it from the
-    /// pixels too costly for the jump), the glass sphere 0.0219 → 0.0217 (+3.9%), the
-    /// tube 0.0306 → 0.0307 (+0.7%); at 400k and 160×120 the glass sphere 0.0172 →
-    /// 0.0154, the two balls the same (0.0173). Also refining every pixel with a grazing
-    /// sample, whatever it gathered, cost 4–7% more rays for the same errors. Held out
-    /// at 1.6M: the sphere + wall 0.0490 → 0.0446 (its worst seed 0.058 → 0.046) for 5%
-    /// more rays, the balls scene 0.0174 → 0.0155 for 5.6%, the tilted cube the same;
-    /// at 12.8M the sphere + wall c's brightest rim pixel reads 2.074 instead of 1.955
-    /// (64×64 everywhere: 2.092; its reference 2.064).
-    ///
-    /// From a first grid too costly for the jump, a grazing pixel refines at least once,
-    /// whatever the error estimate says: both checkerboard halves of a regular grid
-    /// alias a focus seen through the rim alike, and may agree by chance. The sphere +
-    /// wall c's rim pixel (177, 73) at 6.4M photons a light read 2.44 on its 4×4 grid,
-    /// halves 2.45 and 2.43, where its reference reads 2.16 — 89% of the caustic
-    /// region's squared error, 0.155 at 6.4M against 0.078 at 1.6M; with the step 0.054.
-    /// For 0–1% more eye rays, at 1.6M and four seeds: the two balls' worst seed 0.063 →
-    /// 0.039 (tuning), its others and the glass sphere within 0.001, the tube the same
-    /// bits; held out, the sphere + wall within 0.0003.
-    ///
-    /// The halves of the grids after that can agree by chance too, so a grazing pixel
-    /// also asks two grids in a row to agree: its error is at least half the difference
-    /// between the last grid and the one before it. At 1.6M photons the glass sphere's
-    /// rim pixel (172, 145) stopped on an 8×8 grid whose halves agreed, at 1.79, 11%
-    /// under its reference (2.00); it now goes on to 16×16 (1.91). At 1.6M and four
-    /// seeds, for under 1% more eye rays: the glass sphere's caustic region 0.0247
-    /// 0.0201 0.0269 0.0225 → 0.0207 0.0198 0.0269 0.0196, the two balls' 0.0287 0.0394
-    /// 0.0334 0.0310 → 0.0286 0.0329 0.0313 0.0311, the tube and the lens wall the same (tuning); held out, measured
-    /// afterwards, the sphere + wall, the balls scene and the sphere + wall c the same
-    /// or up to 0.001 better, the tilted cube the same bits.
-    ///
-    /// On the desktop the error estimate also answers for the corners: a corner
-    /// brighter or darker than every sample of the grid saw something that lies, as far
-    /// as the grid can tell, within the half sub-pixel around it, `1/(4m²)` of an
-    /// `m × m` grid's pixel, so it counts as at least that share of the corner's
-    /// distance from the samples' range. The two balls' pixel (221, 150) has a focus
-    /// seen through a ball at a corner, 3.19 against at most 0.2 for the 16 samples
-    /// of its 4×4 grid, whose halves agreed: it stopped at 0.140, where a 16×16 grid
-    /// reads 0.267 and the reference 0.281. Tuning scenes at 1.6M, four seeds, for
-    /// 0.3–0.8% more eye rays: the two balls' caustic region 0.0286 0.0329 0.0313
-    /// 0.0311 → 0.0264 0.0310 0.0297 0.0293, the glass sphere, the tube and the lens
-    /// wall the same or up to 0.002 lower.
-    ///
-    /// The error estimate here leaves out what the photons of samples widened far
-    /// explain: seen through a ball near its focus, each sub-pixel's patch is widened to
-    /// the photons' spacing, many times the pixel's preimage, so the checkerboard halves
-    /// differ by the few photons each half's patches hold, and a finer grid would only
-    /// average those photons again. Measured at 1.6M photons, four seeds:
-    /// `scenes/lens_wall.json` 42% fewer eye rays, the render's noise the same to 1%;
-    /// the glass sphere's and the two balls' images the same bits; the tube's caustic
-    /// error 0.0356 → 0.0353 for 3% fewer eye rays. Elsewhere the halves' photon noise
-    /// stays in the test: there a finer grid's sparser sub-patches widen more and do
-    /// average more photons (subtracting it everywhere made the tuning scenes' caustic
-    /// errors 10–19% worse).
+    /// - **Grazing pixels** (a sample of the first grid grazed glass, [`GRAZING`], and
+    ///   gathered more than the pixel's value: a focus seen through a ball's rim) jump
+    ///   to the `4n × 4n` grid where the budget allows, and then refine on to `8n × 8n`
+    ///   within [`GRAZING_RAYS`] budgets. Their first grid, when the jump was too
+    ///   costly, refines at least once whatever its halves say, and each later grid
+    ///   must agree with the one before it (the error is at least half their
+    ///   difference): a regular grid's checkerboard halves alias a sliver of focus
+    ///   alike and can agree on a wrong value. The sphere + wall c's rim pixel
+    ///   (177, 73) at 6.4M photons read 2.44 on its 4×4 grid, halves 2.45 and 2.43,
+    ///   where its reference reads 2.16.
+    /// - **Slivers between the rows.** Where the corners saw different things along
+    ///   their paths (an `edge`) but every sample of the first grid saw the same, the
+    ///   other side lies between the grid's rows: the pixel goes on to the `2n × 2n`
+    ///   grid, whose rows lie between the first's, and from there as its error
+    ///   estimate asks. The sphere + wall c's pixel (172, 72) read 0.21 on a 4×4 grid,
+    ///   0.35 on 16×16 and 32×32 grids, 0.36 in its reference.
+    /// - **Corners** count in the error estimate (see [`Grid::error2`]): the two
+    ///   balls' (221, 150) has a focus seen through a ball at a corner, 3.19 against at
+    ///   most 0.2 for the 16 samples of its 4×4 grid, whose halves agreed.
+    /// - **Photons widened far** are left out of the error estimate: there the halves
+    ///   differ by the few photons each half's patches hold, which a finer grid would
+    ///   only average again (`scenes/lens_wall.json`: 42% fewer eye rays, the same
+    ///   noise). Elsewhere the halves' photon noise stays in the test, since a finer
+    ///   grid's sparser sub-patches widen more and do average more photons.
     fn refine(
         &self,
         x: u32,
