@@ -46,8 +46,9 @@
 //!   coordinates (angle × radius, area `Δθ·∫ w(ρ)·ρ dρ`).
 //!
 //! Only objects that store photons (a diffuse part) and received at least one photon
-//! get texels. A photon carries the object it landed on ([`Photon::surface`]); a point
-//! without (a lookup from the eye pass, a photon made by hand) is matched to the object
+//! get texels. A photon comes with the object it landed on when its source knows it
+//! ([`IlluminationMaps::build_with`]); a point without (a lookup from the eye pass, a
+//! photon made by hand) is matched to the object
 //! whose surface is nearest (within `1e-4·max(1, |x|∞)`), the chart of a box face or
 //! cylinder cap by the normal.
 //!
