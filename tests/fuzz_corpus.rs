@@ -57,6 +57,8 @@ fn broken_seeds_get_clear_errors() {
         ("truncated.json", ""),
         // Found by the fuzzer: its square underflows, and the estimate divided by zero.
         ("subnormal_max_radius.json", "photons.max_radius"),
+        // Found by the fuzzer: 2·10³¹ W/sr overflowed a gather's scale, and 0·∞ gave NaN.
+        ("huge_intensity.json", "lights[0].intensity"),
     ] {
         let text = std::fs::read_to_string(dir.join(name)).unwrap();
         let e = caustic::desktop::parse_scene(&text).unwrap_err();
