@@ -25,12 +25,9 @@ pub const MAX_INTENSITY: f32 = 1e15;
 impl PointLight {
     /// A light; each channel of the intensity must lie between 0 and [`MAX_INTENSITY`].
     pub fn new(position: Vec3, intensity: Rgb) -> Result<Self, Error> {
-        for c in intensity.to_array() {
-            crate::error::in_range(c, 0.0, MAX_INTENSITY, "light intensity")?;
-        }
         Ok(Self {
             position: finite_vec(position, "light position")?,
-            intensity,
+            intensity: intensity.validate_at_most(MAX_INTENSITY, "light intensity")?,
         })
     }
 

@@ -351,8 +351,13 @@ impl Rgb {
 
     /// Checks that every channel is in `[0, 1]` (a reflectance or albedo).
     pub fn validate_unit(self, what: &'static str) -> Result<Self, Error> {
+        self.validate_at_most(1.0, what)
+    }
+
+    /// Checks that every channel is in `[0, max]`.
+    pub fn validate_at_most(self, max: f32, what: &'static str) -> Result<Self, Error> {
         for c in self.to_array() {
-            crate::error::in_range(c, 0.0, 1.0, what)?;
+            crate::error::in_range(c, 0.0, max, what)?;
         }
         Ok(self)
     }

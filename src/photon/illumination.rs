@@ -48,9 +48,8 @@
 //! Only objects that store photons (a diffuse part) and received at least one photon
 //! get texels. A photon comes with the object it landed on when its source knows it
 //! ([`IlluminationMaps::build_with`]); a point without (a lookup from the eye pass, a
-//! photon made by hand) is matched to the object
-//! whose surface is nearest (within `1e-4·max(1, |x|∞)`), the chart of a box face or
-//! cylinder cap by the normal.
+//! photon made by hand) is matched to the object whose surface is nearest (within
+//! `1e-4·max(1, |x|∞)`), the chart of a box face or cylinder cap by the normal.
 //!
 //! # The classic model
 //! The paper's eq. 8 needs each photon's direction `l`. A texel keeps no direction, so
