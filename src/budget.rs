@@ -407,6 +407,7 @@ mod tests {
                 throughput: 1.0,
                 direct: 0.0,
                 curvature: 0.0,
+                visits: crate::photon::FOOTPRINT_VISITS,
             };
             let (e, c) = (
                 capped.irradiance_within(x, up, &f),

@@ -97,6 +97,7 @@ fn a_footprint_gathers_halves_estimate_its_error() {
             throughput: 1.0,
             direct: 0.0,
             curvature: 0.0,
+            visits: photon::FOOTPRINT_VISITS,
         };
         let h = store.irradiance_within(x, UnitVec3::Y, &f);
         let to = (light - x).as_dvec3();

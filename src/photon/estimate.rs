@@ -59,6 +59,17 @@ pub const THINNING: usize = 16;
 /// scaled down about its centre.
 pub const FOOTPRINT_VISITS: usize = 1024;
 
+/// [`FOOTPRINT_VISITS`] for the footprints of a grazing pixel's refined grids (see
+/// `Renderer::refine`): a focus seen through a ball's rim, where every sub-pixel's
+/// footprint would hold thousands of photons. There the cap sets each gather's photons:
+/// on a coarse level they stay about the same however many photons are emitted (16
+/// times the photons move the gather one level coarser), a noise floor that a finer
+/// grid does not lower. The sphere + wall f's 17 rim pixels read 3.19–3.40 over four
+/// seeds at 1.6M photons a light with 1024 (reference 3.17), 3.23–3.28 with this cap.
+/// Raised for these pixels alone, where the grids' secants bound each footprint
+/// (`Renderer::grid`): raised everywhere, the balls scene's run took 17% longer.
+pub const GRAZING_VISITS: usize = 16384;
+
 /// A footprint seen along a path of throughput below this — a reflection off glass
 /// near normal incidence (4%), or light that crossed a glass wall after reflecting
 /// inside it — is gathered on the first coarse level, every [`THINNING`]-th photon,
@@ -478,9 +489,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         };
         let (_, visits, _) = self.sum_in(Some(coarsest), x, n, region, false, None);
         let Some(v) = visits else { return 2 };
-        if v * THINNING * THINNING <= FOOTPRINT_VISITS {
+        if v * THINNING * THINNING <= region.visits {
             0
-        } else if v * THINNING <= FOOTPRINT_VISITS {
+        } else if v * THINNING <= region.visits {
             1
         } else {
             2
@@ -504,9 +515,9 @@ impl<'a, const K: usize, const N: usize> KdStore<'a, K, N> {
         mut weight: Option<&mut dyn FnMut(UnitVec3, Rgb) -> Rgb>,
     ) -> ([Rgb; 2], Option<usize>, [u32; 2]) {
         let cap = if weight.is_some() {
-            FOOTPRINT_VISITS
+            region.visits
         } else {
-            FOOTPRINT_VISITS / THINNING
+            region.visits / THINNING
         };
         let mut sum = [Rgb::ZERO; 2];
         let Some(tree) = tree else {
@@ -684,6 +695,7 @@ mod tests {
             throughput: 1.0,
             direct: 0.0,
             curvature: 0.0,
+            visits: FOOTPRINT_VISITS,
         };
         let region = Region::new(&fp(a, b), 1.0).unwrap();
         let cut = region.cut();
@@ -717,18 +729,7 @@ mod tests {
     fn a_faint_footprint_is_gathered_on_the_first_coarse_level() {
         let mut g = Pcg32::new(5);
         let up = UnitVec3::Y;
-        let mut photons: Vec<Photon> = (0..64_000)
-            .map(|i| {
-                let p = Vec3::new(g.next_f32() * 4.0 - 2.0, 0.0, g.next_f32() * 4.0 - 2.0);
-                let power = Rgb::splat(1.0 + g.next_f32());
-                Photon::new(p, -up, power).with_half(i % 2 == 0)
-            })
-            .collect();
-        let mut level1: Vec<Photon> = photons.iter().step_by(THINNING).copied().collect();
-        let mut level2: Vec<Photon> = level1.iter().step_by(THINNING).copied().collect();
-        for level in [&mut photons, &mut level1, &mut level2] {
-            balance(level);
-        }
+        let [photons, level1, level2] = levels(&mut g);
         let tree = KdTree::from_balanced(&photons);
         let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None).with_coarse_levels(
             KdTree::from_balanced(&level1),
@@ -755,6 +756,7 @@ mod tests {
                 throughput: 0.5 * FAINT,
                 direct: 0.0,
                 curvature: 0.0,
+                visits: FOOTPRINT_VISITS,
             };
             let (sum, area) = brute(&level1, x, &faint);
             let want = sum * THINNING as f32 / area;
@@ -790,6 +792,79 @@ mod tests {
             differ > 90,
             "the faint gathers read the map itself: {differ}"
         );
+    }
+
+    /// 64 000 photons uniform over the square `[−2, 2]²` of the plane `y = 0` (4 000 a
+    /// unit of area), balanced, with the two coarse levels of every [`THINNING`]-th.
+    fn levels(g: &mut Pcg32) -> [Vec<Photon>; 3] {
+        let mut photons: Vec<Photon> = (0..64_000)
+            .map(|i| {
+                let p = Vec3::new(g.next_f32() * 4.0 - 2.0, 0.0, g.next_f32() * 4.0 - 2.0);
+                let power = Rgb::splat(1.0 + g.next_f32());
+                Photon::new(p, -UnitVec3::Y, power).with_half(i % 2 == 0)
+            })
+            .collect();
+        let mut level1: Vec<Photon> = photons.iter().step_by(THINNING).copied().collect();
+        let mut level2: Vec<Photon> = level1.iter().step_by(THINNING).copied().collect();
+        for level in [&mut photons, &mut level1, &mut level2] {
+            balance(level);
+        }
+        [photons, level1, level2]
+    }
+
+    /// A footprint holding about 2 000 photons (a square 0.7 on a side) is gathered on
+    /// the first coarse level under [`FOOTPRINT_VISITS`] — the brute-force sum of that
+    /// level's photons inside it, each counted [`THINNING`] times — and on the map
+    /// itself, every photon once, under [`GRAZING_VISITS`].
+    #[test]
+    fn the_visit_cap_chooses_the_level() {
+        let mut g = Pcg32::new(9);
+        let [photons, level1, level2] = levels(&mut g);
+        let store: KdStore<'_, 8> =
+            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None).with_coarse_levels(
+                KdTree::from_balanced(&level1),
+                KdTree::from_balanced(&level2),
+            );
+        let sum_inside = |level: &[Photon], x: Vec3, f: &Footprint| {
+            let region = Region::new(f, 1.0).unwrap();
+            let inside = level
+                .iter()
+                .filter(|p| region.coordinates().of(p.position() - x).is_some());
+            (
+                inside.map(|p| p.power().r).sum::<f32>(),
+                inside_count(level, x, f),
+            )
+        };
+        for q in 0..20 {
+            let x = Vec3::new(g.next_f32() - 0.5, 0.0, g.next_f32() - 0.5);
+            let capped = Footprint {
+                visits: FOOTPRINT_VISITS,
+                ..square(0.35)
+            };
+            let (coarse, _) = sum_inside(&level1, x, &capped);
+            let (fine, held) = sum_inside(&photons, x, &capped);
+            assert!(held > FOOTPRINT_VISITS, "footprint {q} holds {held}");
+            let area = 4.0 * 0.35 * 0.35;
+            let got = store.irradiance_within(x, UnitVec3::Y, &capped).total.r;
+            let want = coarse * THINNING as f32 / area;
+            assert!((got - want).abs() <= 1e-4 * want, "{q}: {got} {want}");
+            let grazing = Footprint {
+                visits: GRAZING_VISITS,
+                ..capped
+            };
+            let got = store.irradiance_within(x, UnitVec3::Y, &grazing).total.r;
+            assert!((got - fine / area).abs() <= 1e-4 * got, "{q}: {got}");
+        }
+    }
+
+    /// The photons of `level` inside footprint `f` about `x`.
+    fn inside_count(level: &[Photon], x: Vec3, f: &Footprint) -> usize {
+        let region = Region::new(f, 1.0).unwrap();
+        let coordinates = region.coordinates();
+        level
+            .iter()
+            .filter(|p| coordinates.of(p.position() - x).is_some())
+            .count()
     }
 
     /// `uniform_quarter` is the two-sided binomial test it claims, for the counts the
@@ -965,6 +1040,7 @@ mod tests {
             throughput: 1.0,
             direct: 0.0,
             curvature: 0.0,
+            visits: FOOTPRINT_VISITS,
         }
     }
 
@@ -1161,6 +1237,7 @@ mod tests {
                 b: short + shear,
                 direct: 0.0,
                 curvature,
+                visits: FOOTPRINT_VISITS,
             };
             let Some(region) = Region::new(&fp, store.max_radius2) else {
                 continue;

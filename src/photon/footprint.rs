@@ -37,6 +37,13 @@ pub struct Footprint {
     /// within the sagitta of that reach off the plane; one farther off lies on another
     /// surface and is not counted (see `Region::thickness`).
     pub curvature: f32,
+    /// Most photons one search for it may visit on one level: [`FOOTPRINT_VISITS`],
+    /// or [`GRAZING_VISITS`] in a grazing pixel's refined grids. Past it the gather
+    /// moves to a coarser level (see [`KdStore`](super::KdStore)).
+    ///
+    /// [`FOOTPRINT_VISITS`]: super::FOOTPRINT_VISITS
+    /// [`GRAZING_VISITS`]: super::GRAZING_VISITS
+    pub visits: usize,
 }
 
 /// Most disks one footprint's search is cut into (see `Region::segments`).
@@ -59,6 +66,8 @@ pub(super) struct Region {
     parallelogram: bool,
     /// The surface's curvature ([`Footprint::curvature`]).
     curvature: f32,
+    /// The footprint's visit cap ([`Footprint::visits`]).
+    pub(super) visits: usize,
 }
 
 impl Region {
@@ -93,6 +102,7 @@ impl Region {
                 area: 4.0 * crate::math::sqrt(det),
                 parallelogram: true,
                 curvature: f.curvature,
+                visits: f.visits,
             })
         } else {
             Some(Self {
@@ -105,6 +115,7 @@ impl Region {
                 area: PI * reach2,
                 parallelogram: false,
                 curvature: f.curvature,
+                visits: f.visits,
             })
         }
     }
@@ -123,6 +134,7 @@ impl Region {
             area: self.area * s2,
             parallelogram: self.parallelogram,
             curvature: self.curvature,
+            visits: self.visits,
         }
     }
 

@@ -20,8 +20,8 @@ mod splat;
 mod trace;
 
 pub use estimate::{
-    ConeFilter, KdStore, FAINT, FOOTPRINT_VISITS, MAGNIFIED, MAGNIFIED_WIDENINGS, SPARSE_FOOTPRINT,
-    THINNING,
+    ConeFilter, KdStore, FAINT, FOOTPRINT_VISITS, GRAZING_VISITS, MAGNIFIED, MAGNIFIED_WIDENINGS,
+    SPARSE_FOOTPRINT, THINNING,
 };
 
 pub use footprint::Footprint;

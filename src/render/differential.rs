@@ -175,16 +175,73 @@ pub(crate) struct Trail<const DEPTH: usize> {
     vertices: FixedVec<Vertex, DEPTH>,
     /// The sample's extent on the image, pixels (`1/m` for an `m × m` grid).
     step: f32,
+    /// What bounds its footprints beyond the differentials.
+    bounds: Bounds,
+}
+
+/// What bounds a sample's footprints beyond its differentials: the photons each search
+/// may visit on one level ([`Footprint::visits`](crate::photon::Footprint::visits)),
+/// and in a grazing pixel's refined grids the secants to its neighbours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Bounds {
+    pub visits: usize,
+    pub secant: Option<Secant>,
+}
+
+impl Bounds {
+    /// The usual cap, no secant.
+    pub const PLAIN: Bounds = Bounds {
+        visits: crate::photon::FOOTPRINT_VISITS,
+        secant: None,
+    };
+}
+
+/// Where a sample's heavy path first gathers (see `Renderer::probe`), and the longest
+/// the footprint's half-axes there may be along the image's x and y: half the distance
+/// between the points where its grid neighbours' heavy paths gather (the secants of the
+/// map from image to surface, see `Renderer::grid`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Secant {
+    pub at: Vec3,
+    pub half: [f32; 2],
 }
 
 impl<const DEPTH: usize> Trail<DEPTH> {
-    /// No vertex yet, for a sample `step` pixels wide.
+    /// No vertex yet, for a sample `step` pixels wide whose footprints `bounds` bound.
     #[inline]
-    pub fn new(step: f32) -> Self {
+    pub fn new(step: f32, bounds: Bounds) -> Self {
         Self {
             vertices: FixedVec::new(),
             step,
+            bounds,
         }
+    }
+
+    /// The photons each search of the sample's footprints may visit on one level.
+    #[inline]
+    pub fn visits(&self) -> usize {
+        self.bounds.visits
+    }
+
+    /// The footprint's half-axes `[a, b]` (the image's x and y) at `point`, each
+    /// shortened to its secant's length where the sample's [`Secant`] is at `point`
+    /// and the differentials' tangent says more: at a ball's silhouette the view
+    /// through it turns faster than linearly, and the tangent overstated the spacing
+    /// of neighbouring sub-pixels' points 2.6–3.2 times (`docs/accuracy.md`, session
+    /// 30). Never lengthened: where the map is near linear the two agree.
+    #[inline]
+    pub fn bounded(&self, point: Vec3, axes: [Vec3; 2]) -> [Vec3; 2] {
+        let Some(s) = self.bounds.secant.filter(|s| s.at == point) else {
+            return axes;
+        };
+        let mut out = axes;
+        for (axis, half) in out.iter_mut().zip(s.half) {
+            let length = crate::math::sqrt(axis.length_squared());
+            if length > half {
+                *axis *= half / length;
+            }
+        }
+        out
     }
 
     /// Records the specular hit of a branch at `depth` that arrived along `d` by `bend`,
@@ -377,7 +434,7 @@ mod tests {
         let entry = |x: f32, eta: f32| {
             let ray = Ray::new(Vec3::new(x, 0.0, 5.0), UnitVec3::new(-Vec3::Z).unwrap());
             let hit = ball.intersect(&ray, f32::INFINITY).unwrap();
-            let mut trail = Trail::<2>::new(1.0);
+            let mut trail = Trail::<2>::new(1.0, Bounds::PLAIN);
             trail.record(0, (ray.dir, Bend::Reflect), &hit, 0, eta);
             trail.grazes(0.15)
         };
@@ -385,7 +442,7 @@ mod tests {
         assert!(!entry(0.98, 1.0 / 1.5)); // cos 0.199
         assert!(entry(0.995, 1.0 / 1.5)); // cos 0.0999
         assert!(!entry(0.995, 1.0)); // a mirror
-        assert!(!Trail::<2>::new(1.0).grazes(0.15));
+        assert!(!Trail::<2>::new(1.0, Bounds::PLAIN).grazes(0.15));
     }
 
     /// Replaying the trail gives, bit for bit, the differentials carried through every
@@ -405,7 +462,7 @@ mod tests {
                 let ray = camera.ray_at(px, py, 0.25, 0.75);
                 let dd = camera.direction_derivatives(ray.dir);
                 let carried = dd.map(|d| Differential::camera(d * step));
-                let mut trail = Trail::<4>::new(step);
+                let mut trail = Trail::<4>::new(step, Bounds::PLAIN);
                 let mut stack: std::vec::Vec<Pending> = std::vec![(ray, 0, Bend::Reflect, carried)];
                 while let Some((ray, depth, bend, carried)) = stack.pop() {
                     let Some((hit, index)) = scene.intersect(&ray, f32::INFINITY) else {
@@ -448,5 +505,25 @@ mod tests {
             checked >= 1000 && overwritten >= 10,
             "{checked}, {overwritten}"
         );
+    }
+
+    /// A secant bounds the footprint only at its own point, shortens an axis longer
+    /// than it to its length along the same direction, and never lengthens one.
+    #[test]
+    fn a_secant_only_shortens_its_own_footprint() {
+        let at = Vec3::new(0.0, 0.0, 1.0);
+        let secant = Secant {
+            at,
+            half: [0.5, 4.0],
+        };
+        let bounds = Bounds {
+            visits: 1,
+            secant: Some(secant),
+        };
+        let trail = Trail::<2>::new(1.0, bounds);
+        let axes = [Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];
+        assert_eq!(trail.bounded(at, axes), [Vec3::new(0.0, 0.5, 0.0), axes[1]]);
+        assert_eq!(trail.bounded(at + Vec3::X * 1e-3, axes), axes);
+        assert_eq!(Trail::<2>::new(1.0, Bounds::PLAIN).bounded(at, axes), axes);
     }
 }

@@ -66,10 +66,10 @@ use heapless::Vec as FixedVec;
 use crate::error::Error;
 use crate::geometry::{Hit, Ray, Shape};
 use crate::material::{interface, Classic, Material};
-use crate::math::{reflect, Rgb, UnitVec3};
+use crate::math::{reflect, Rgb, UnitVec3, Vec3};
 use crate::photon::{CausticStore, Footprint, Halves, Splat};
 use crate::scene::Scene;
-use differential::{Bend, Trail};
+use differential::{Bend, Bounds, Trail};
 
 mod differential;
 mod estimate;
@@ -187,6 +187,26 @@ impl Child {
             bend: self.bend,
         }
     }
+}
+
+/// The heavier of a fork's two branches (the larger channel sum; the first on a tie),
+/// which the path follows at once, and the other.
+#[inline]
+fn heavier([first, second]: [Option<Child>; 2]) -> (Option<Child>, Option<Child>) {
+    let sum = |c: &Option<Child>| c.map_or(0.0, |c| c.weight.r + c.weight.g + c.weight.b);
+    if sum(&second) > sum(&first) {
+        (second, first)
+    } else {
+        (first, second)
+    }
+}
+
+/// Where a sample's path first gathers at full weight ([`Renderer::probe`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Probe {
+    point: Vec3,
+    depth: u32,
+    object: usize,
 }
 
 /// Radiance along one eye ray, its caustic part, and a signature of what the path met:
@@ -353,17 +373,24 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
 
     /// Radiance arriving at the origin of `ray` along it, with the path's signature.
     pub fn sample(&self, ray: Ray, count: &mut RayCount) -> Sample {
-        self.sample_within(ray, 1, count).0
+        self.sample_within(ray, 1, Bounds::PLAIN, count).0
     }
 
     /// As [`sample`](Self::sample), for one ray of an `m × m` grid over the pixel: the
-    /// gathers behind glass average over its sub-pixel's patch of surface. Also `true`
-    /// when the ray entered glass at grazing incidence ([`GRAZING`]; only with a store
-    /// that reads magnifications, the desktop's: see `refine`).
-    pub(crate) fn sample_within(&self, ray: Ray, m: u32, count: &mut RayCount) -> (Sample, bool) {
+    /// gathers behind glass average over its sub-pixel's patch of surface, within
+    /// `bounds`. Also `true` when the ray entered glass at grazing incidence
+    /// ([`GRAZING`]; only with a store that reads magnifications, the desktop's: see
+    /// `refine`).
+    pub(crate) fn sample_within(
+        &self,
+        ray: Ray,
+        m: u32,
+        bounds: Bounds,
+        count: &mut RayCount,
+    ) -> (Sample, bool) {
         let mut stack: FixedVec<Branch, DEPTH> = FixedVec::new();
         let mut out = Sample::START;
-        let mut trail = Trail::new(1.0 / m.max(1) as f32);
+        let mut trail = Trail::new(1.0 / m.max(1) as f32, bounds);
         let mut b = Branch {
             ray,
             weight: Rgb::ONE,
@@ -380,19 +407,12 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 if self.significant(&b) {
                     out.mix(index as u32 | b.depth << 16);
                 }
-                let (local, [first, second]) =
-                    self.scatter(&b, &hit, index, &mut trail, count, &mut out);
+                let (local, children) = self.scatter(&b, &hit, index, &mut trail, count, &mut out);
                 out.radiance += local;
                 // Continue with the heavier branch, keep the other for later (a
                 // different depth from every branch already waiting, so the stack never
                 // overflows). Each is made where it goes, not moved there.
-                let sum =
-                    |c: &Option<Child>| c.map_or(0.0, |c| c.weight.r + c.weight.g + c.weight.b);
-                let (heavier, lighter) = if sum(&second) > sum(&first) {
-                    (second, first)
-                } else {
-                    (first, second)
-                };
+                let (heavier, lighter) = heavier(children);
                 let depth = b.depth + 1;
                 if let Some(c) = lighter {
                     if stack.push(c.branch(&hit, depth)).is_err() {
@@ -417,6 +437,42 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         // Constant false on a device's store: not compiled there.
         let grazing = self.store.reads_direct() && trail.grazes(GRAZING);
         (out, grazing)
+    }
+
+    /// Where the path of `ray` (one ray of an `m × m` grid) first gathers at full weight:
+    /// following the heavier branch at every fork as [`sample_within`](Self::sample_within)
+    /// does, its first hit on the front of a diffuse surface after a specular vertex,
+    /// if the branch there carries at least half the light (a `classic` surface, a
+    /// miss or the end of the path: `None`). Shades nothing: the points of a grid's
+    /// samples, traced first, give each sample the secants that bound its footprint
+    /// (see `grid`).
+    pub(crate) fn probe(&self, ray: Ray, m: u32) -> Option<Probe> {
+        let mut trail = Trail::new(1.0 / m.max(1) as f32, Bounds::PLAIN);
+        let (mut count, mut log) = (RayCount::default(), Sample::START);
+        let mut b = Branch {
+            ray,
+            weight: Rgb::ONE,
+            depth: 0,
+            bend: Bend::Reflect,
+        };
+        loop {
+            let (hit, index) = self.scene.intersect(&b.ray, f32::INFINITY)?;
+            match self.scene.objects()[index].material {
+                Material::Diffuse(_) => {
+                    let full = b.weight.max_channel() >= 0.5;
+                    let seen = b.depth >= 1 && full && hit.front_face(b.ray.dir);
+                    return seen.then_some(Probe {
+                        point: hit.point,
+                        depth: b.depth,
+                        object: index,
+                    });
+                }
+                Material::Classic(_) => return None,
+                Material::Mirror(_) | Material::Dielectric(_) => {}
+            }
+            let (_, children) = self.scatter(&b, &hit, index, &mut trail, &mut count, &mut log);
+            b = heavier(children).0?.branch(&hit, b.depth + 1);
+        }
     }
 
     /// How the caustic store gathers at the diffuse point `hit` reached by branch `b`:
@@ -447,14 +503,16 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         } else {
             0.0
         };
-        let [a, b] =
+        let axes =
             diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
+        let [a, b] = trail.bounded(hit.point, axes);
         Gather::Footprint(Footprint {
             a,
             b,
             throughput,
             direct,
             curvature: shape.curvature(hit.normal),
+            visits: trail.visits(),
         })
     }
 
