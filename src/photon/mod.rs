@@ -34,7 +34,9 @@ pub use kdtree::{
     balance, balance_subtree, split_subtree, Found, KdTree, Neighbor, Subtree, BUCKET,
 };
 pub use packed::Photon;
-pub use splat::{add_to_frame, add_to_row, Splat, SplatStorage, SplatTarget};
+#[cfg(feature = "std")]
+pub use splat::add_to_frame;
+pub use splat::{add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;
 

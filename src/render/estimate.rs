@@ -73,6 +73,12 @@ impl SplatTarget for PixelEstimate {
             self.split += s.radiance;
         }
     }
+    #[inline]
+    fn add_sums(&mut self, total: Rgb, split: Rgb) {
+        self.radiance += total;
+        self.caustic += total;
+        self.split += split;
+    }
 }
 
 /// Sums over an image's pixels for its estimated relative RMSE, row by row (each row

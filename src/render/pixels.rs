@@ -237,7 +237,11 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     ///   difference): a regular grid's checkerboard halves alias a sliver of focus
     ///   alike and can agree on a wrong value. The sphere + wall c's rim pixel
     ///   (177, 73) at 6.4M photons read 2.44 on its 4×4 grid, halves 2.45 and 2.43,
-    ///   where its reference reads 2.16.
+    ///   where its reference reads 2.16. Their grids after the first are
+    ///   [`grazing_grid`](Self::grazing_grid)s: more photons a gather, within
+    ///   footprints bounded by secants (chosen on the held-out sphere + wall f and
+    ///   sphere + wall, whose floor and silhouette it answers: session 31 of
+    ///   `docs/accuracy.md`).
     /// - **Slivers between the rows.** Where the corners saw different things along
     ///   their paths (an `edge`) but every sample of the first grid saw the same, the
     ///   other side lies between the grid's rows: the pixel goes on to the `2n × 2n`
