@@ -729,18 +729,12 @@ mod tests {
     fn a_faint_footprint_is_gathered_on_the_first_coarse_level() {
         let mut g = Pcg32::new(5);
         let up = UnitVec3::Y;
-        let [photons, level1, level2] = levels(&mut g);
-        let tree = KdTree::from_balanced(&photons);
-        let store: KdStore<'_, 8> = KdStore::new(tree, 1.0, None, 1.0, None).with_coarse_levels(
-            KdTree::from_balanced(&level1),
-            KdTree::from_balanced(&level2),
-        );
+        let levels = levels(&mut g);
+        let [photons, level1, level2] = &levels;
+        let store = store_with_levels(&levels);
         let brute = |level: &[Photon], x: Vec3, f: &Footprint| {
-            let region = Region::new(f, 1.0).unwrap();
-            let inside = level
-                .iter()
-                .filter(|p| region.coordinates().of(p.position() - x).is_some());
-            (inside.map(|p| p.power().r).sum::<f32>(), region.area)
+            let (sum, area, _) = inside(level, x, f);
+            (sum, area)
         };
         let mut differ = 0;
         for q in 0..100 {
@@ -758,7 +752,7 @@ mod tests {
                 curvature: 0.0,
                 visits: FOOTPRINT_VISITS,
             };
-            let (sum, area) = brute(&level1, x, &faint);
+            let (sum, area) = brute(level1, x, &faint);
             let want = sum * THINNING as f32 / area;
             let got = store.irradiance_within(x, up, &faint).total.r;
             assert!(
@@ -769,7 +763,7 @@ mod tests {
                 throughput: 0.5 * FAINT * FAINT,
                 ..faint
             };
-            let (sum, area) = brute(&level2, x, &fainter);
+            let (sum, area) = brute(level2, x, &fainter);
             let want = sum * (THINNING * THINNING) as f32 / area;
             let got2 = store.irradiance_within(x, up, &fainter).total.r;
             assert!(
@@ -780,7 +774,7 @@ mod tests {
                 throughput: 1.0,
                 ..faint
             };
-            let (sum, area) = brute(&photons, x, &full);
+            let (sum, area) = brute(photons, x, &full);
             let fine = store.irradiance_within(x, up, &full).total.r;
             assert!(
                 (fine - sum / area).abs() <= 1e-4 * fine.max(1.0),
@@ -819,52 +813,46 @@ mod tests {
     #[test]
     fn the_visit_cap_chooses_the_level() {
         let mut g = Pcg32::new(9);
-        let [photons, level1, level2] = levels(&mut g);
-        let store: KdStore<'_, 8> =
-            KdStore::new(KdTree::from_balanced(&photons), 1.0, None, 1.0, None).with_coarse_levels(
-                KdTree::from_balanced(&level1),
-                KdTree::from_balanced(&level2),
-            );
-        let sum_inside = |level: &[Photon], x: Vec3, f: &Footprint| {
-            let region = Region::new(f, 1.0).unwrap();
-            let inside = level
-                .iter()
-                .filter(|p| region.coordinates().of(p.position() - x).is_some());
-            (
-                inside.map(|p| p.power().r).sum::<f32>(),
-                inside_count(level, x, f),
-            )
-        };
+        let levels = levels(&mut g);
+        let store = store_with_levels(&levels);
+        let (half, up) = (0.35, UnitVec3::Y);
         for q in 0..20 {
             let x = Vec3::new(g.next_f32() - 0.5, 0.0, g.next_f32() - 0.5);
             let capped = Footprint {
                 visits: FOOTPRINT_VISITS,
-                ..square(0.35)
+                ..square(half)
             };
-            let (coarse, _) = sum_inside(&level1, x, &capped);
-            let (fine, held) = sum_inside(&photons, x, &capped);
+            let (coarse, area, _) = inside(&levels[1], x, &capped);
+            let (fine, _, held) = inside(&levels[0], x, &capped);
             assert!(held > FOOTPRINT_VISITS, "footprint {q} holds {held}");
-            let area = 4.0 * 0.35 * 0.35;
-            let got = store.irradiance_within(x, UnitVec3::Y, &capped).total.r;
+            let got = store.irradiance_within(x, up, &capped).total.r;
             let want = coarse * THINNING as f32 / area;
             assert!((got - want).abs() <= 1e-4 * want, "{q}: {got} {want}");
             let grazing = Footprint {
                 visits: GRAZING_VISITS,
                 ..capped
             };
-            let got = store.irradiance_within(x, UnitVec3::Y, &grazing).total.r;
+            let got = store.irradiance_within(x, up, &grazing).total.r;
             assert!((got - fine / area).abs() <= 1e-4 * got, "{q}: {got}");
         }
     }
 
-    /// The photons of `level` inside footprint `f` about `x`.
-    fn inside_count(level: &[Photon], x: Vec3, f: &Footprint) -> usize {
+    /// [`store_of`] `levels[0]`, with `levels[1]` and `levels[2]` its coarse levels.
+    fn store_with_levels(levels: &[Vec<Photon>; 3]) -> KdStore<'_, 8> {
+        let [_, level1, level2] = levels.each_ref().map(|l| KdTree::from_balanced(l));
+        store_of(&levels[0]).with_coarse_levels(level1, level2)
+    }
+
+    /// The photons of `level` inside footprint `f` about `x` (a radius of 1): the sum of
+    /// their red power, the footprint's area and their count.
+    fn inside(level: &[Photon], x: Vec3, f: &Footprint) -> (f32, f32, usize) {
         let region = Region::new(f, 1.0).unwrap();
         let coordinates = region.coordinates();
-        level
+        let inside = level
             .iter()
-            .filter(|p| coordinates.of(p.position() - x).is_some())
-            .count()
+            .filter(|p| coordinates.of(p.position() - x).is_some());
+        let (sum, count) = inside.fold((0.0, 0), |(s, c), p| (s + p.power().r, c + 1));
+        (sum, region.area, count)
     }
 
     /// `uniform_quarter` is the two-sided binomial test it claims, for the counts the
