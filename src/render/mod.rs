@@ -445,7 +445,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// if the branch there carries at least half the light (a `classic` surface, a
     /// miss or the end of the path: `None`). Shades nothing: the points of a grid's
     /// samples, traced first, give each sample the secants that bound its footprint
-    /// (see `grid`).
+    /// (see `grazing_grid`).
     pub(crate) fn probe(&self, ray: Ray, m: u32) -> Option<Probe> {
         let mut trail = Trail::new(1.0 / m.max(1) as f32, Bounds::PLAIN);
         let (mut count, mut log) = (RayCount::default(), Sample::START);
@@ -505,14 +505,26 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         };
         let axes =
             diffs.map(|diff| diff.transfer(b.ray.dir.get(), hit.t, hit.normal.get()).dp * 0.5);
-        let [a, b] = trail.bounded(hit.point, axes);
+        // Constant false on a device's store, whose grids are never grazing ones: the
+        // secants and the larger cap are not compiled there.
+        let desktop = self.store.reads_direct();
+        let [a, b] = if desktop {
+            trail.bounded(hit.point, axes)
+        } else {
+            axes
+        };
+        let visits = if desktop {
+            trail.visits()
+        } else {
+            crate::photon::FOOTPRINT_VISITS
+        };
         Gather::Footprint(Footprint {
             a,
             b,
             throughput,
             direct,
             curvature: shape.curvature(hit.normal),
-            visits: trail.visits(),
+            visits,
         })
     }
 
