@@ -164,6 +164,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let mut shared = None;
         let mut uniform = true;
         let mut range = NO_RANGE;
+        // Constant false on a device's store: its grids keep no lines.
+        let desktop = self.store.reads_direct();
+        let mut lines = Lines::new(if desktop { n } else { 0 });
         for sy in 0..n {
             for sx in 0..n {
                 let (fx, fy) = ((sx as f32 + 0.5) * step, (sy as f32 + 0.5) * step);
@@ -174,6 +177,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                     grazing = crate::math::max(grazing, s.caustic.luminance());
                 }
                 uniform &= *shared.get_or_insert(s.signature) == s.signature;
+                if desktop {
+                    lines.add(sx, sy, s.signature, s.radiance.luminance());
+                }
                 range = widen(range, s.radiance.luminance());
                 let k = ((sx + sy) & 1) as usize;
                 // Constant false on a device's store: not compiled there.
@@ -211,6 +217,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             sampling2,
         };
         Grid {
+            aligned: lines.aligned2(),
             grazing: grazing > pixel.radiance.luminance(),
             uniform,
             range,
@@ -248,6 +255,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     ///   grid, whose rows lie between the first's, and from there as its error
     ///   estimate asks. The sphere + wall c's pixel (172, 72) read 0.21 on a 4×4 grid,
     ///   0.35 on 16×16 and 32×32 grids, 0.36 in its reference.
+    /// - **Edges between the rows** count in the error estimate (see [`Lines::aligned2`]):
+    ///   the sphere + wall g's floor shadow, nearly along the image's rows, stopped at
+    ///   4×4 grids whose halves agreed, a quarter of a pixel out.
     /// - **Corners** count in the error estimate (see [`Grid::error2`]): the two
     ///   balls' (221, 150) has a focus seen through a ball at a corner, 3.19 against at
     ///   most 0.2 for the 16 samples of its 4×4 grid, whose halves agreed.
@@ -513,6 +523,9 @@ struct Grid {
     uniform: bool,
     /// The least and the greatest luminance of its samples.
     range: (f32, f32),
+    /// The squared luminance error of where an edge between its rows or between its
+    /// columns lies ([`Lines::aligned2`]; 0 on a device's store).
+    aligned: f32,
 }
 
 impl Grid {
@@ -521,9 +534,12 @@ impl Grid {
     /// of samples widened far explain; on the desktop (`corners`: the pixel's corner
     /// luminances) at least each corner's distance from the samples' range times the
     /// half sub-pixel around it, `1/(4m²)` of the pixel — what it saw may lie there,
-    /// unsampled; and with the `coarser` grid's luminance before it (a grazing pixel)
+    /// unsampled; with the `coarser` grid's luminance before it (a grazing pixel)
     /// at least half their difference — halves that alias a sliver alike can agree on a
-    /// wrong value twice in a row, two grids of different sides rarely do.
+    /// wrong value twice in a row, two grids of different sides rarely do; and on the
+    /// desktop at least the error of an edge that runs between the grid's rows or
+    /// columns ([`Lines::aligned2`]), which its halves, each with samples on every row
+    /// and column, see alike.
     fn error2(&self, m: u32, corners: Option<[f32; 4]>, coarser: Option<f32>) -> f32 {
         let mut e = self.pixel.sampling2.luminance() - self.photons;
         let w = 1.0 / (4 * m * m) as f32;
@@ -535,7 +551,89 @@ impl Grid {
             let d = (self.pixel.radiance.luminance() - c) * 0.5;
             e = crate::math::max(e, d * d);
         }
+        if corners.is_some() {
+            e = crate::math::max(e, self.aligned);
+        }
         e
+    }
+}
+
+/// The largest grid side whose rows and columns [`Lines`] follows.
+const LINES: usize = 16;
+
+/// The rows and the columns of an `n × n` grid (`n ≤` [`LINES`]; none kept otherwise):
+/// whether each saw one signature alone, and its samples' luminance summed.
+struct Lines {
+    n: usize,
+    rows: [Line; LINES],
+    columns: [Line; LINES],
+}
+
+/// One row or column of a grid (see [`Lines`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct Line {
+    signature: Option<u32>,
+    same: bool,
+    sum: f32,
+}
+
+impl Line {
+    fn add(&mut self, signature: u32, luminance: f32) {
+        match self.signature {
+            None => (self.signature, self.same) = (Some(signature), true),
+            Some(s) => self.same &= s == signature,
+        }
+        self.sum += luminance;
+    }
+}
+
+impl Lines {
+    fn new(n: u32) -> Self {
+        Self {
+            n: n as usize,
+            rows: [Line::default(); LINES],
+            columns: [Line::default(); LINES],
+        }
+    }
+
+    fn add(&mut self, sx: u32, sy: u32, signature: u32, luminance: f32) {
+        if let (Some(row), Some(column)) = (
+            self.rows.get_mut(sy as usize).filter(|_| self.n <= LINES),
+            self.columns.get_mut(sx as usize),
+        ) {
+            row.add(signature, luminance);
+            column.add(signature, luminance);
+        }
+    }
+
+    /// The squared luminance error of an edge that runs between the grid's rows (or
+    /// its columns): where every row saw one signature alone but not all the same, the
+    /// grid puts the edge on the boundary between two rows, wherever it lies within
+    /// the row spacing `1/n` — an error of the step `Δ` between those rows' means
+    /// times a uniform offset in `±1/(2n)`, of variance `Δ²/(12n²)`; the largest step
+    /// of either direction. The sphere + wall g's floor shadow, nearly along the rows,
+    /// read 0.114 against 0.074 on 4×4 grids whose checkerboard halves agreed
+    /// (`docs/accuracy.md`, session 31); session 28 found the same edges on the
+    /// sphere + wall c. Zero without an edge, or past [`LINES`].
+    fn aligned2(&self) -> f32 {
+        if !(2..=LINES).contains(&self.n) {
+            return 0.0;
+        }
+        let n = self.n as f32;
+        let step = |lines: &[Line]| {
+            if !lines.iter().all(|l| l.same) {
+                return 0.0;
+            }
+            let steps = lines
+                .windows(2)
+                .filter(|w| w[0].signature != w[1].signature);
+            steps.fold(0.0, |s, w| {
+                crate::math::max(s, ((w[0].sum - w[1].sum) / n).abs())
+            })
+        };
+        let [rows, columns] = [&self.rows, &self.columns].map(|l| step(&l[..self.n]));
+        let s = crate::math::max(rows, columns);
+        s * s / (12.0 * n * n)
     }
 }
 
@@ -677,6 +775,7 @@ mod tests {
             grazing: false,
             uniform: false,
             range: (1.0, 2.0),
+            aligned: 0.0,
         }
     }
 
@@ -701,6 +800,35 @@ mod tests {
         // The largest wins whichever comes first.
         assert!(close(g.error2(4, corners, Some(1.1)), 0.04));
         assert!(close(grid(0.5).error2(4, corners, Some(1.1)), 0.25));
+        // An edge between the rows counts on the desktop (with corners) alone.
+        let edge = Grid { aligned: 0.3, ..g };
+        assert!(close(edge.error2(4, Some([1.5; 4]), None), 0.3));
+        assert!(close(edge.error2(4, None, None), 1e-4));
+    }
+
+    /// A 4×4 grid whose top two rows saw one thing at luminance 1 and bottom two
+    /// another at 0: an edge between rows, a step of 1, variance `1/(12·16)`; the same
+    /// turned on its side between columns; an edge that crosses a row (a sample of the
+    /// row seeing the other side) or no edge at all: nothing.
+    #[test]
+    fn an_edge_between_rows_or_columns_has_the_rows_rounding_error() {
+        let lines = |side: fn(u32, u32) -> bool| {
+            let mut l = Lines::new(4);
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    let lit = side(sx, sy);
+                    l.add(sx, sy, lit as u32, if lit { 1.0 } else { 0.0 });
+                }
+            }
+            l.aligned2()
+        };
+        let want = 1.0 / (12.0 * 16.0);
+        assert!((lines(|_, sy| sy < 2) - want).abs() < 1e-7);
+        assert!((lines(|sx, _| sx >= 1) - want).abs() < 1e-7);
+        assert_eq!(lines(|sx, sy| sx + sy < 3), 0.0);
+        assert_eq!(lines(|sx, sy| sy < 2 || (sx, sy) == (0, 2)), 0.0);
+        assert_eq!(lines(|_, _| true), 0.0);
+        assert_eq!(Lines::new(32).aligned2(), 0.0);
     }
 
     /// The central secant halves a neighbour's spacing (two steps over four), the
