@@ -597,8 +597,11 @@ impl Lines {
     }
 
     fn add(&mut self, sx: u32, sy: u32, signature: u32, luminance: f32) {
+        if self.n > LINES {
+            return; // a grid too fine to follow: aligned2 reads nothing
+        }
         if let (Some(row), Some(column)) = (
-            self.rows.get_mut(sy as usize).filter(|_| self.n <= LINES),
+            self.rows.get_mut(sy as usize),
             self.columns.get_mut(sx as usize),
         ) {
             row.add(signature, luminance);
