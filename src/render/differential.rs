@@ -186,6 +186,8 @@ pub(crate) struct Trail<const DEPTH: usize> {
 pub(crate) struct Bounds {
     pub visits: usize,
     pub secant: Option<Secant>,
+    /// Whether the sample gathers at all (`false`: its caustic part comes from elsewhere).
+    pub gathers: bool,
 }
 
 impl Bounds {
@@ -193,6 +195,7 @@ impl Bounds {
     pub const PLAIN: Bounds = Bounds {
         visits: crate::photon::FOOTPRINT_VISITS,
         secant: None,
+        gathers: true,
     };
 }
 
@@ -221,6 +224,12 @@ impl<const DEPTH: usize> Trail<DEPTH> {
     #[inline]
     pub fn visits(&self) -> usize {
         self.bounds.visits
+    }
+
+    /// Whether the sample gathers (see [`Bounds::gathers`]).
+    #[inline]
+    pub fn gathers(&self) -> bool {
+        self.bounds.gathers
     }
 
     /// The footprint's half-axes `[a, b]` (the image's x and y) at `point`, each
@@ -519,6 +528,7 @@ mod tests {
         let bounds = Bounds {
             visits: 1,
             secant: Some(secant),
+            gathers: true,
         };
         let trail = Trail::<2>::new(1.0, bounds);
         let axes = [Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];

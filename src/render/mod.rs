@@ -77,8 +77,8 @@ mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{
-    CornerLine, RowPixel, Sampling, CONTRAST, GRAZING, GRAZING_RAYS, REFINE, REFINE_RAYS,
-    REFINE_TOLERANCE, SIGNATURE_WEIGHT,
+    CornerLine, RowPixel, Sampling, CAUSTIC_SHARE, CONTRAST, GRAZING, GRAZING_RAYS, REFINE,
+    REFINE_RAYS, REFINE_TOLERANCE, SIGNATURE_WEIGHT,
 };
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
@@ -492,7 +492,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// half-steps of its differentials there, where a photon may lie within reach.
     #[inline(never)]
     fn behind(&self, b: &Branch, (hit, shape): (&Hit, &Shape), trail: &Trail<DEPTH>) -> Gather {
-        if !self.store.reaches(hit.point) {
+        if !trail.gathers() || !self.store.reaches(hit.point) {
             return Gather::Dark;
         }
         let (camera, objects) = (self.scene.camera(), self.scene.objects());
