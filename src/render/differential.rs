@@ -180,14 +180,14 @@ pub(crate) struct Trail<const DEPTH: usize> {
 }
 
 /// What bounds a sample's footprints beyond its differentials: the photons each search
-/// may visit on one level ([`Footprint::visits`](crate::photon::Footprint::visits)),
-/// and in a grazing pixel's refined grids the secants to its neighbours.
+/// may visit on one level ([`Footprint::visits`](crate::photon::Footprint::visits);
+/// none, [`Bounds::NO_GATHER`], when the sample's caustic part comes from elsewhere and
+/// it does not gather at all), and in a grazing pixel's refined grids the secants to
+/// its neighbours.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Bounds {
     pub visits: usize,
     pub secant: Option<Secant>,
-    /// Whether the sample gathers at all (`false`: its caustic part comes from elsewhere).
-    pub gathers: bool,
 }
 
 impl Bounds {
@@ -195,8 +195,10 @@ impl Bounds {
     pub const PLAIN: Bounds = Bounds {
         visits: crate::photon::FOOTPRINT_VISITS,
         secant: None,
-        gathers: true,
     };
+
+    /// No gather at all: no photon may be visited.
+    pub const NO_GATHER: usize = 0;
 }
 
 /// Where a sample's heavy path first gathers (see `Renderer::probe`), and the longest
@@ -224,12 +226,6 @@ impl<const DEPTH: usize> Trail<DEPTH> {
     #[inline]
     pub fn visits(&self) -> usize {
         self.bounds.visits
-    }
-
-    /// Whether the sample gathers (see [`Bounds::gathers`]).
-    #[inline]
-    pub fn gathers(&self) -> bool {
-        self.bounds.gathers
     }
 
     /// The footprint's half-axes `[a, b]` (the image's x and y) at `point`, each
@@ -528,7 +524,6 @@ mod tests {
         let bounds = Bounds {
             visits: 1,
             secant: Some(secant),
-            gathers: true,
         };
         let trail = Trail::<2>::new(1.0, bounds);
         let axes = [Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];

@@ -492,7 +492,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// half-steps of its differentials there, where a photon may lie within reach.
     #[inline(never)]
     fn behind(&self, b: &Branch, (hit, shape): (&Hit, &Shape), trail: &Trail<DEPTH>) -> Gather {
-        if !trail.gathers() || !self.store.reaches(hit.point) {
+        // Constant false on a device's store, whose samples always gather.
+        let settled = self.store.reads_direct() && trail.visits() == Bounds::NO_GATHER;
+        if settled || !self.store.reaches(hit.point) {
             return Gather::Dark;
         }
         let (camera, objects) = (self.scene.camera(), self.scene.objects());

@@ -192,32 +192,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 let before = count.widened;
                 let ray = camera.ray_at(x, y, fx, fy);
                 let b = bounds(sx, sy);
-                let (s, grazes) = match &mut cells {
-                    Cells::Take(c) => match c.cell(sx, sy, n) {
-                        Some(cell) => {
-                            let without = Bounds {
-                                gathers: false,
-                                ..b
-                            };
-                            let (mut s, g) = self.sample_within(ray, n, without, count);
-                            if s.signature == cell.0 {
-                                s.radiance += cell.1;
-                                s.caustic = cell.1;
-                                s.split = cell.2;
-                                (s, g)
-                            } else {
-                                self.sample_within(ray, n, b, count)
-                            }
-                        }
-                        None => self.sample_within(ray, n, b, count),
-                    },
-                    Cells::Keep(c) => {
-                        let (s, g) = self.sample_within(ray, n, b, count);
-                        c.keep(sx, sy, n, &s);
-                        (s, g)
-                    }
-                    Cells::Own => self.sample_within(ray, n, b, count),
-                };
+                let (s, grazes) = self.sample_in(ray, n, b, (sx, sy), &mut cells, count);
                 if grazes {
                     grazing = crate::math::max(grazing, s.caustic.luminance());
                 }
@@ -247,7 +222,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         } else {
             Rgb::ZERO
         };
-        let caustic2 = if half[1].2 > 0 {
+        let caustic2 = if cfg!(feature = "std") && desktop && half[1].2 > 0 {
             let d =
                 (half[0].1 * (1.0 / half[0].2 as f32) - half[1].1 * (1.0 / half[1].2 as f32)) * 0.5;
             (d * d).luminance()
@@ -277,6 +252,64 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             pixel,
             photons,
         }
+    }
+
+    /// Sample `(sx, sy)` of an `n × n` grid along `ray`, as [`Cells`] asks: a finer
+    /// grid's sample that sees the same paths as its cell's first-grid sample traces
+    /// them without gathering and takes that sample's caustic part (see
+    /// [`refine`](Self::refine)); the first grid's samples are kept.
+    #[cfg(feature = "std")]
+    #[inline]
+    fn sample_in(
+        &self,
+        ray: crate::geometry::Ray,
+        n: u32,
+        b: Bounds,
+        (sx, sy): (u32, u32),
+        cells: &mut Cells<'_>,
+        count: &mut RayCount,
+    ) -> (Sample, bool) {
+        if !self.store.reads_direct() {
+            return self.sample_within(ray, n, b, count); // a device's store keeps none
+        }
+        match cells {
+            Cells::Take(c) => {
+                let Some(cell) = c.cell(sx, sy, n) else {
+                    return self.sample_within(ray, n, b, count);
+                };
+                let without = Bounds {
+                    visits: Bounds::NO_GATHER,
+                    ..b
+                };
+                let (mut s, g) = self.sample_within(ray, n, without, count);
+                if s.signature != cell.0 {
+                    return self.sample_within(ray, n, b, count); // across an edge
+                }
+                (s.radiance, s.caustic, s.split) = (s.radiance + cell.1, cell.1, cell.2);
+                (s, g)
+            }
+            Cells::Keep(c) => {
+                let (s, g) = self.sample_within(ray, n, b, count);
+                c.keep(sx, sy, n, &s);
+                (s, g)
+            }
+            Cells::Own => self.sample_within(ray, n, b, count),
+        }
+    }
+
+    /// On a device, every sample gathers for itself.
+    #[cfg(not(feature = "std"))]
+    #[inline]
+    fn sample_in(
+        &self,
+        ray: crate::geometry::Ray,
+        n: u32,
+        b: Bounds,
+        _: (u32, u32),
+        _: &mut Cells<'_>,
+        count: &mut RayCount,
+    ) -> (Sample, bool) {
+        self.sample_within(ray, n, b, count)
     }
 
     /// Pixel `(x, y)` on an `n × n` grid, then `2n × 2n` and `4n × 4n` while the
@@ -352,7 +385,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let share = crate::math::max(first.pixel.radiance.luminance(), bright)
             * REFINE_TOLERANCE
             * CAUSTIC_SHARE;
-        let settled = desktop
+        let settled = cfg!(feature = "std")
+            && desktop
             && first.caustic2 <= share * share
             && first.corners2(n, corners) <= share * share;
         let take = || {
@@ -638,8 +672,10 @@ impl Grid {
     /// and column, see alike.
     fn error2(&self, m: u32, corners: Option<[f32; 4]>, coarser: Option<f32>) -> f32 {
         let mut e = self.pixel.sampling2.luminance() - self.photons;
-        if let Some(c) = corners {
-            e = crate::math::max(e, self.corners2(m, c));
+        let w = 1.0 / (4 * m * m) as f32;
+        for l in corners.into_iter().flatten() {
+            let d = (l - crate::math::clamp(l, self.range.0, self.range.1)) * w;
+            e = crate::math::max(e, d * d);
         }
         if let Some(c) = coarser {
             let d = (self.pixel.radiance.luminance() - c) * 0.5;
@@ -809,7 +845,6 @@ impl ProbeRows {
         Bounds {
             visits: GRAZING_VISITS,
             secant,
-            gathers: true,
         }
     }
 }
@@ -838,6 +873,8 @@ fn one(s: &Sample) -> PixelEstimate {
 }
 
 /// How a grid's samples use the pixel's first grid (see [`Renderer::refine`]).
+// A device's samples all gather for themselves: it reads no cell.
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 enum Cells<'c> {
     /// Not at all: each sample gathers its own caustic part.
     Own,
@@ -901,10 +938,6 @@ struct Coarse;
 impl Coarse {
     fn new(_: u32) -> Self {
         Self
-    }
-    fn keep(&mut self, _: u32, _: u32, _: u32, _: &crate::render::Sample) {}
-    fn cell(&self, _: u32, _: u32, _: u32) -> Option<(u32, Rgb, Rgb)> {
-        None
     }
 }
 
