@@ -257,8 +257,8 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Sample `(sx, sy)` of an `n × n` grid along `ray`, as [`Cells`] asks: a finer
     /// grid's sample that sees the same paths as its cell's first-grid sample traces
     /// them without gathering and takes that sample's caustic part (see
-    /// [`refine`](Self::refine)); the first grid's samples are kept.
-    #[cfg(feature = "std")]
+    /// [`refine`](Self::refine)); the first grid's samples are kept. A device's build
+    /// keeps no cells: there every sample gathers for itself.
     #[inline]
     fn sample_in(
         &self,
@@ -269,46 +269,34 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         cells: &mut Cells<'_>,
         count: &mut RayCount,
     ) -> (Sample, bool) {
-        if !self.store.reads_direct() {
-            return self.sample_within(ray, n, b, count); // a device's store keeps none
-        }
-        match cells {
-            Cells::Take(c) => {
-                let Some(cell) = c.cell(sx, sy, n) else {
-                    return self.sample_within(ray, n, b, count);
-                };
-                let without = Bounds {
-                    visits: Bounds::NO_GATHER,
-                    ..b
-                };
-                let (mut s, g) = self.sample_within(ray, n, without, count);
-                if s.signature != cell.0 {
-                    return self.sample_within(ray, n, b, count); // across an edge
+        #[cfg(feature = "std")]
+        if self.store.reads_direct() {
+            match cells {
+                Cells::Take(c) => {
+                    if let Some(cell) = c.cell(sx, sy, n) {
+                        let without = Bounds {
+                            visits: Bounds::NO_GATHER,
+                            ..b
+                        };
+                        let (mut s, g) = self.sample_within(ray, n, without, count);
+                        // Across an edge the sample gathers for itself after all.
+                        if s.signature == cell.0 {
+                            (s.radiance, s.caustic, s.split) =
+                                (s.radiance + cell.1, cell.1, cell.2);
+                            return (s, g);
+                        }
+                    }
                 }
-                (s.radiance, s.caustic, s.split) = (s.radiance + cell.1, cell.1, cell.2);
-                (s, g)
+                Cells::Keep(c) => {
+                    let (s, g) = self.sample_within(ray, n, b, count);
+                    c.keep(sx, sy, n, &s);
+                    return (s, g);
+                }
+                Cells::Own => {}
             }
-            Cells::Keep(c) => {
-                let (s, g) = self.sample_within(ray, n, b, count);
-                c.keep(sx, sy, n, &s);
-                (s, g)
-            }
-            Cells::Own => self.sample_within(ray, n, b, count),
         }
-    }
-
-    /// On a device, every sample gathers for itself.
-    #[cfg(not(feature = "std"))]
-    #[inline]
-    fn sample_in(
-        &self,
-        ray: crate::geometry::Ray,
-        n: u32,
-        b: Bounds,
-        _: (u32, u32),
-        _: &mut Cells<'_>,
-        count: &mut RayCount,
-    ) -> (Sample, bool) {
+        #[cfg(not(feature = "std"))]
+        let _ = (sx, sy, cells);
         self.sample_within(ray, n, b, count)
     }
 
