@@ -71,6 +71,7 @@ use crate::photon::{CausticStore, Footprint, Halves, Splat};
 use crate::scene::Scene;
 use differential::{Bend, Bounds, Trail};
 
+mod cells;
 mod differential;
 mod estimate;
 mod pixels;
