@@ -42,9 +42,10 @@ impl Coarse {
         }
     }
 
-    /// Keeps sample `(sx, sy)` of the `n × n` first grid.
-    pub(super) fn keep(&mut self, sx: u32, sy: u32, n: u32, s: &Sample) {
-        if n == self.n && (n as usize) <= COARSE {
+    /// Keeps sample `(sx, sy)` of the first grid.
+    pub(super) fn keep(&mut self, sx: u32, sy: u32, s: &Sample) {
+        let n = self.n;
+        if (n as usize) <= COARSE {
             if let Some(c) = self.cells.get_mut((sy * n + sx) as usize) {
                 *c = (s.signature, s.caustic, s.split);
             }
@@ -94,7 +95,7 @@ mod tests {
                     caustic: Rgb::splat(sx as f32),
                     ..Sample::default()
                 };
-                c.keep(sx, sy, n, &s);
+                c.keep(sx, sy, &s);
             }
         }
         for m in [8, 16, 32] {

@@ -216,16 +216,19 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         let inv = 1.0 / (n * n) as f32;
+        // Half the difference of the checkerboard halves' means of one part.
+        let halves = |part: fn(&(Rgb, Rgb, u32)) -> Rgb| {
+            (part(&half[0]) * (1.0 / half[0].2 as f32) - part(&half[1]) * (1.0 / half[1].2 as f32))
+                * 0.5
+        };
         let sampling2 = if half[1].2 > 0 {
-            let d =
-                (half[0].0 * (1.0 / half[0].2 as f32) - half[1].0 * (1.0 / half[1].2 as f32)) * 0.5;
+            let d = halves(|h| h.0);
             d * d
         } else {
             Rgb::ZERO
         };
-        let caustic2 = if cfg!(feature = "std") && desktop && half[1].2 > 0 {
-            let d =
-                (half[0].1 * (1.0 / half[0].2 as f32) - half[1].1 * (1.0 / half[1].2 as f32)) * 0.5;
+        let caustic2 = if desktop && half[1].2 > 0 {
+            let d = halves(|h| h.1);
             (d * d).luminance()
         } else {
             0.0
@@ -290,7 +293,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
                 Cells::Keep(c) => {
                     let (s, g) = self.sample_within(ray, n, b, count);
-                    c.keep(sx, sy, n, &s);
+                    c.keep(sx, sy, &s);
                     return (s, g);
                 }
                 Cells::Own => {}
@@ -374,10 +377,9 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         let share = crate::math::max(first.pixel.radiance.luminance(), bright)
             * REFINE_TOLERANCE
             * CAUSTIC_SHARE;
-        let settled = cfg!(feature = "std")
-            && desktop
+        let settled = desktop
             && first.caustic2 <= share * share
-            && first.corners2(n, corners) <= share * share;
+            && first.corners2(n, corners, 0.0) <= share * share;
         let take = || {
             if settled {
                 Cells::Take(coarse)
@@ -637,12 +639,13 @@ struct Grid {
 }
 
 impl Grid {
-    /// The largest squared error that a corner of luminance outside the range of this
-    /// `m × m` grid's samples stands for: its distance from the range times the half
-    /// sub-pixel around it, `1/(4m²)` of the pixel (see [`error2`](Self::error2)).
-    fn corners2(&self, m: u32, corners: [f32; 4]) -> f32 {
+    /// The largest of `e` and the squared errors that the `corners` of luminance
+    /// outside the range of this `m × m` grid's samples stand for: each one's distance
+    /// from the range times the half sub-pixel around it, `1/(4m²)` of the pixel (see
+    /// [`error2`](Self::error2)).
+    fn corners2(&self, m: u32, corners: [f32; 4], e: f32) -> f32 {
         let w = 1.0 / (4 * m * m) as f32;
-        corners.into_iter().fold(0.0, |e, l| {
+        corners.into_iter().fold(e, |e, l| {
             let d = (l - crate::math::clamp(l, self.range.0, self.range.1)) * w;
             crate::math::max(e, d * d)
         })
@@ -661,10 +664,8 @@ impl Grid {
     /// and column, see alike.
     fn error2(&self, m: u32, corners: Option<[f32; 4]>, coarser: Option<f32>) -> f32 {
         let mut e = self.pixel.sampling2.luminance() - self.photons;
-        let w = 1.0 / (4 * m * m) as f32;
-        for l in corners.into_iter().flatten() {
-            let d = (l - crate::math::clamp(l, self.range.0, self.range.1)) * w;
-            e = crate::math::max(e, d * d);
+        if let Some(c) = corners {
+            e = self.corners2(m, c, e);
         }
         if let Some(c) = coarser {
             let d = (self.pixel.radiance.luminance() - c) * 0.5;
