@@ -12,7 +12,8 @@ use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
 use crate::error::within;
 use crate::photon::{
-    self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat, Subtree,
+    self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
+    SplatSums, Subtree,
 };
 use crate::scene::Scene;
 use crate::Error;
@@ -23,7 +24,9 @@ use crate::Error;
 pub struct PhotonBuffer {
     photons: vec::Vec<Photon>,
     unit: f32,
-    splats: vec::Vec<Splat>,
+    /// The camera splats of the pass, summed per pixel as their chunks arrive in
+    /// emission order: no list of them is kept.
+    splats: SplatSums,
     /// The coarse levels of the store (see [`KdStore::with_coarse_levels`]), balanced.
     coarse: [vec::Vec<Photon>; 2],
 }
@@ -138,14 +141,15 @@ impl<'a> Pool<'a> {
     }
 }
 
-/// The forward pass's chunks, appended to the buffer in emission order as they finish.
+/// The forward pass's chunks, appended to the buffer in emission order as they finish
+/// (their splats added to the sums, in the same order).
 struct InOrder<'a> {
     /// The first chunk not yet appended.
     next: usize,
     /// Finished chunks waiting for an earlier one.
     done: vec::Vec<Option<Chunk>>,
     photons: &'a mut vec::Vec<Photon>,
-    splats: &'a mut vec::Vec<Splat>,
+    splats: &'a mut SplatSums,
     coarse: &'a mut [vec::Vec<Photon>; 2],
 }
 
@@ -163,7 +167,7 @@ impl InOrder<'_> {
         self.done[k] = Some(chunk);
         while let Some(c) = self.done.get_mut(self.next).and_then(Option::take) {
             self.photons.extend_from_slice(&c.photons);
-            self.splats.extend_from_slice(&c.splats);
+            self.splats.add(&c.splats);
             for (level, from) in self.coarse.iter_mut().zip(&c.coarse) {
                 level.extend_from_slice(from);
             }
@@ -189,7 +193,7 @@ impl PhotonBuffer {
         Ok(Self {
             photons: vec::Vec::with_capacity(needed),
             unit: 0.0,
-            splats: vec::Vec::new(),
+            splats: SplatSums::default(),
             coarse: [vec::Vec::new(), vec::Vec::new()],
         })
     }
@@ -227,7 +231,9 @@ impl PhotonBuffer {
         // the buffer in emission order by whichever thread finishes the next one due,
         // while the others trace on.
         self.photons.clear();
-        self.splats.clear();
+        let camera = scene.camera();
+        self.splats
+            .clear(camera.width() as usize * camera.height() as usize);
         self.coarse.iter_mut().for_each(vec::Vec::clear);
         // The coarse levels: photons chosen by their emission index
         // (`Emitter::coarse_levels`), each standing for THINNING of the level before.
@@ -310,8 +316,8 @@ impl PhotonBuffer {
         self.unit
     }
 
-    /// The camera splats of the last pass, in emission order.
-    pub fn splats(&self) -> &[Splat] {
+    /// The camera splats of the last pass, summed per pixel in emission order.
+    pub fn splats(&self) -> &SplatSums {
         &self.splats
     }
 }

@@ -19,9 +19,7 @@ use super::progress::Progress;
 use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
-use crate::photon::{
-    self, add_to_frame, CausticStore, Footprint, Halves, Photon, PhotonSettings, Splat,
-};
+use crate::photon::{self, CausticStore, Footprint, Halves, Photon, PhotonSettings, SplatSums};
 use crate::render::{
     CornerLine, ErrorTally, PixelEstimate, RayCount, Renderer, Sample, Sampling, REFINE,
 };
@@ -411,7 +409,7 @@ fn backward_pass<S: CausticStore + Sync>(
     scene: &DesktopScene,
     store: &S,
     settings: &PhotonSettings,
-    splats: Option<&[Splat]>,
+    splats: Option<&SplatSums>,
     opts: &RenderOptions,
     progress: &Progress,
     stats: &mut RenderStats,
@@ -426,8 +424,10 @@ fn backward_pass<S: CausticStore + Sync>(
     if let Some(budget) = opts.max_rays_per_sample {
         renderer = renderer.with_ray_budget(budget)?;
     }
-    if let Some(splats) = splats {
-        renderer = renderer.with_splats(splats);
+    if splats.is_some() {
+        // Only to say that the splats hold the caustics seen directly: the rows do not
+        // read them, and their sums are added to the frame below.
+        renderer = renderer.with_splats(&[]);
     }
     let cam = scene.camera();
     let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
@@ -440,8 +440,8 @@ fn backward_pass<S: CausticStore + Sync>(
         progress,
     );
     if let Some(splats) = splats {
-        add_to_frame(splats, &mut frame);
-        stats.photons_splatted += splats.len() as u64;
+        splats.add_to(&mut frame);
+        stats.photons_splatted += splats.count();
     }
     stats.render_ms += ms(t.elapsed());
     stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
@@ -545,7 +545,9 @@ pub fn render_illumination(
     stats.balance_ms += ms(t.elapsed());
     progress.tick();
     progress.phase(0, "rows", h as usize);
-    let splats = settings.camera_splats().then_some(&splats[..]);
+    let mut sums = SplatSums::new((w * h) as usize);
+    sums.add(&splats);
+    let splats = settings.camera_splats().then_some(&sums);
     let frame = backward_pass(scene, &maps, settings, splats, opts, &progress, &mut stats)?;
     progress.finish();
     let mut sum = Passes::new(w as usize, frame.len());

@@ -35,7 +35,7 @@ pub use kdtree::{
 };
 pub use packed::Photon;
 #[cfg(feature = "std")]
-pub use splat::add_to_frame;
+pub use splat::{add_to_frame, SplatSums};
 pub use splat::{add_to_row, Splat, SplatStorage, SplatTarget};
 
 use emit::Emission;

@@ -183,20 +183,69 @@ pub fn add_to_row<T: SplatTarget>(splats: &[Splat], y: u32, row: &mut [T]) {
 /// 31). A device's short list keeps `add_to_row`: its rows hold no room for `f64` sums.
 #[cfg(feature = "std")]
 pub fn add_to_frame<T: SplatTarget>(splats: &[Splat], frame: &mut [T]) {
-    let mut sums = std::vec![[[0.0f64; 3]; 2]; frame.len()];
-    for s in splats {
-        if let Some(sum) = sums.get_mut(s.pixel() as usize) {
-            let (half, r) = (&mut sum[s.half() as usize], s.radiance);
-            for (acc, v) in half.iter_mut().zip([r.r, r.g, r.b]) {
-                *acc += v as f64;
-            }
+    let mut sums = SplatSums::new(frame.len());
+    sums.add(splats);
+    sums.add_to(frame);
+}
+
+/// The splats of a frame summed per pixel and per half in `f64`, as [`add_to_frame`]
+/// sums them: fed in emission order a batch at a time ([`add`](Self::add)), so that a
+/// forward pass can sum each chunk of photons as it is appended and keep no list of
+/// splats, then added to the frame once ([`add_to`](Self::add_to)). The same sums, bit
+/// for bit, as one [`add_to_frame`] over the whole list.
+#[cfg(feature = "std")]
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SplatSums {
+    /// Per pixel, per half, the sum of the splats' radiance (r, g, b).
+    sums: std::vec::Vec<[[f64; 3]; 2]>,
+    /// Splats added since the last [`clear`](Self::clear).
+    count: u64,
+}
+
+#[cfg(feature = "std")]
+impl SplatSums {
+    /// Zero sums for a frame of `pixels` pixels.
+    pub fn new(pixels: usize) -> Self {
+        Self {
+            sums: std::vec![[[0.0; 3]; 2]; pixels],
+            count: 0,
         }
     }
-    let rgb = |c: [f64; 3]| Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32);
-    for (px, [h0, h1]) in frame.iter_mut().zip(&sums) {
-        if h0 != &[0.0; 3] || h1 != &[0.0; 3] {
-            let total = rgb([0, 1, 2].map(|i| h0[i] + h1[i]));
-            px.add_sums(total, rgb([0, 1, 2].map(|i| h0[i] - h1[i])));
+
+    /// Zero sums again, for a frame of `pixels` pixels (a new pass).
+    pub fn clear(&mut self, pixels: usize) {
+        self.sums.clear();
+        self.sums.resize(pixels, [[0.0; 3]; 2]);
+        self.count = 0;
+    }
+
+    /// Adds `splats`, in their order; one outside the frame is counted and dropped.
+    pub fn add(&mut self, splats: &[Splat]) {
+        for s in splats {
+            if let Some(sum) = self.sums.get_mut(s.pixel() as usize) {
+                let (half, r) = (&mut sum[s.half() as usize], s.radiance);
+                for (acc, v) in half.iter_mut().zip([r.r, r.g, r.b]) {
+                    *acc += v as f64;
+                }
+            }
+        }
+        self.count += splats.len() as u64;
+    }
+
+    /// Splats added.
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    /// Adds each pixel's sum, and its halves' difference, to `frame` (row-major, as
+    /// many pixels as the sums; a pixel no splat reached is left alone).
+    pub fn add_to<T: SplatTarget>(&self, frame: &mut [T]) {
+        let rgb = |c: [f64; 3]| Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32);
+        for (px, [h0, h1]) in frame.iter_mut().zip(&self.sums) {
+            if h0 != &[0.0; 3] || h1 != &[0.0; 3] {
+                let total = rgb([0, 1, 2].map(|i| h0[i] + h1[i]));
+                px.add_sums(total, rgb([0, 1, 2].map(|i| h0[i] - h1[i])));
+            }
         }
     }
 }

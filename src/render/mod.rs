@@ -323,8 +323,9 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// The caustics seen directly come from these splats of the forward pass (in
     /// emission order): [`rows`](Self::rows) adds them to their pixels, and the store
     /// gathers only where a diffuse point is seen through glass or in a mirror, within
-    /// the pixel's footprint. [`row`](Self::row) does not add them (the desktop adds
-    /// all at once with [`add_to_frame`](crate::photon::add_to_frame)).
+    /// the pixel's footprint. [`row`](Self::row) does not add them: the desktop sums
+    /// them as its forward pass makes them ([`SplatSums`](crate::photon::SplatSums)) and
+    /// passes an empty list here, which says only that the splats hold those caustics.
     pub fn with_splats(mut self, splats: &'a [Splat]) -> Self {
         self.splats = Some(splats);
         self
