@@ -45,6 +45,9 @@ pub(crate) struct Cone {
     solid_angle: f32,
     /// Photons aimed into this cone.
     count: u32,
+    /// Its photons' density over directions, `count / solid_angle` (per steradian),
+    /// computed once: every photon sums it over the cones that hold its direction.
+    density: f32,
 }
 
 impl Cone {
@@ -130,6 +133,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                 one_minus_cos,
                 solid_angle,
                 count: 0,
+                density: 0.0,
             });
         }
         if cones.is_empty() || total >= 4.0 * PI {
@@ -148,6 +152,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
             };
             let upto = upto.min(count).max(given);
             c.count = upto - given;
+            c.density = c.count as f32 / c.solid_angle;
             given = upto;
         }
         Emission::Cones(cones)
@@ -215,10 +220,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         match self {
             Emission::Sphere { count } => i * 4.0 * PI / (*count).max(1) as f32,
             Emission::Cones(c) => {
-                let density: f32 = c
-                    .iter()
-                    .map(|c| c.count as f32 / c.solid_angle)
-                    .fold(0.0, f32::max);
+                let density: f32 = c.iter().map(|c| c.density).fold(0.0, f32::max);
                 if density > 0.0 {
                     i / density
                 } else {
@@ -261,7 +263,7 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
                     .iter()
                     .enumerate()
                     .filter(|&(j, o)| j == which || o.contains(dir))
-                    .map(|(_, o)| o.count as f32 / o.solid_angle)
+                    .map(|(_, o)| o.density)
                     .sum();
                 (dir, light.intensity() * (1.0 / density), local, which)
             }
