@@ -11,12 +11,16 @@ use super::progress::Progress;
 use super::run::{ms, RenderStats};
 use super::MAX_PHOTONS;
 use crate::error::within;
+use crate::math::Vec3;
 use crate::photon::{
     self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
     SplatSums, Subtree,
 };
 use crate::scene::Scene;
 use crate::Error;
+
+/// The bounding box of no photon.
+const EMPTY: (Vec3, Vec3) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
 
 /// The photon array of the forward pass, on the heap: allocated once for a budget and
 /// refilled in place by every progressive pass (fixed memory, Knaus & Zwicker 2011).
@@ -29,6 +33,8 @@ pub struct PhotonBuffer {
     splats: SplatSums,
     /// The coarse levels of the store (see [`KdStore::with_coarse_levels`]), balanced.
     coarse: [vec::Vec<Photon>; 2],
+    /// The bounding box of `photons`, merged from the chunks' boxes.
+    bounds: (Vec3, Vec3),
 }
 
 /// Photons one forward pass of `settings` stores at most; an error beyond the desktop's
@@ -151,14 +157,16 @@ struct InOrder<'a> {
     photons: &'a mut vec::Vec<Photon>,
     splats: &'a mut SplatSums,
     coarse: &'a mut [vec::Vec<Photon>; 2],
+    bounds: &'a mut (Vec3, Vec3),
 }
 
-/// One chunk's photons, splats and the photons of each coarse level.
-#[derive(Default)]
+/// One chunk's photons, splats and the photons of each coarse level, and the
+/// bounding box of its photons.
 struct Chunk {
     photons: vec::Vec<Photon>,
     splats: vec::Vec<Splat>,
     coarse: [vec::Vec<Photon>; 2],
+    bounds: (Vec3, Vec3),
 }
 
 impl InOrder<'_> {
@@ -171,6 +179,8 @@ impl InOrder<'_> {
             for (level, from) in self.coarse.iter_mut().zip(&c.coarse) {
                 level.extend_from_slice(from);
             }
+            let (lo, hi) = c.bounds;
+            *self.bounds = (self.bounds.0.min(lo), self.bounds.1.max(hi));
             self.next += 1;
         }
     }
@@ -195,6 +205,7 @@ impl PhotonBuffer {
             unit: 0.0,
             splats: SplatSums::default(),
             coarse: [vec::Vec::new(), vec::Vec::new()],
+            bounds: EMPTY,
         })
     }
 
@@ -235,6 +246,7 @@ impl PhotonBuffer {
         self.splats
             .clear(camera.width() as usize * camera.height() as usize);
         self.coarse.iter_mut().for_each(vec::Vec::clear);
+        self.bounds = EMPTY;
         // The coarse levels: photons chosen by their emission index
         // (`Emitter::coarse_levels`), each standing for THINNING of the level before.
         // Only the footprint gathers behind glass read them, and those need the camera
@@ -246,6 +258,7 @@ impl PhotonBuffer {
             photons: &mut self.photons,
             splats: &mut self.splats,
             coarse: &mut self.coarse,
+            bounds: &mut self.bounds,
         });
         let next = AtomicUsize::new(0);
         std::thread::scope(|scope| {
@@ -257,7 +270,9 @@ impl PhotonBuffer {
                     };
                     let mut chunk = Chunk {
                         photons: vec::Vec::with_capacity(CHUNK as usize),
-                        ..Chunk::default()
+                        splats: vec::Vec::new(),
+                        coarse: [vec::Vec::new(), vec::Vec::new()],
+                        bounds: EMPTY,
                     };
                     for i in start..end {
                         let landed = emitter.land(l, i, |x| {
@@ -277,6 +292,8 @@ impl PhotonBuffer {
                         });
                         let Ok(()) = landed;
                     }
+                    // Read while the chunk's photons are in this core's cache.
+                    chunk.bounds = photon::bounding_box(&chunk.photons);
                     if let Ok(mut order) = order.lock() {
                         order.finish(k, chunk);
                     }
@@ -307,8 +324,11 @@ impl PhotonBuffer {
         settings: &PhotonSettings,
     ) -> Result<KdStore<'_, K>, Error> {
         let [level1, level2] = &self.coarse;
-        Ok(photon::store_over::<K>(self.tree(), self.unit, settings)?
-            .with_coarse_levels(KdTree::from_balanced(level1), KdTree::from_balanced(level2)))
+        debug_assert_eq!(self.bounds, photon::bounding_box(&self.photons));
+        Ok(
+            photon::store_within::<K>(self.tree(), self.unit, settings, self.bounds)?
+                .with_coarse_levels(KdTree::from_balanced(level1), KdTree::from_balanced(level2)),
+        )
     }
 
     /// Power of one stored unit, W.

@@ -30,6 +30,7 @@ pub use illumination::{
 };
 #[cfg(feature = "std")]
 pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
+pub(crate) use kdtree::bounding_box;
 pub use kdtree::{
     balance, balance_subtree, split_subtree, Found, KdTree, Neighbor, Subtree, BUCKET,
 };
@@ -719,6 +720,17 @@ pub fn store_over<'a, const K: usize>(
     unit: f32,
     settings: &PhotonSettings,
 ) -> Result<KdStore<'a, K>, Error> {
+    store_within(tree, unit, settings, bounding_box(tree.photons()))
+}
+
+/// [`store_over`] with the bounding box of the tree's photons given (see
+/// [`KdStore::within_box`]).
+pub(crate) fn store_within<'a, const K: usize>(
+    tree: KdTree<'a>,
+    unit: f32,
+    settings: &PhotonSettings,
+    bounds: (Vec3, Vec3),
+) -> Result<KdStore<'a, K>, Error> {
     if !settings.fixed_radius && settings.k as usize > K {
         return Err(Error::Capacity {
             what: "photons.k (gather size)",
@@ -727,13 +739,8 @@ pub fn store_over<'a, const K: usize>(
         });
     }
     let k = (!settings.fixed_radius).then_some(settings.k as usize);
-    Ok(KdStore::new(
-        tree,
-        unit,
-        k,
-        settings.max_radius,
-        settings.cone,
-    ))
+    let gather = (k, settings.max_radius, settings.cone);
+    Ok(KdStore::within_box(tree, unit, gather, bounds))
 }
 
 impl Photon {
