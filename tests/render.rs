@@ -7,7 +7,7 @@ use caustic::camera::Camera;
 use caustic::desktop::image::compare;
 use caustic::desktop::photons::PhotonBuffer;
 use caustic::desktop::progress::Progress;
-use caustic::desktop::run::render_rows;
+use caustic::desktop::rows::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
 use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Ray, Shape};
@@ -361,11 +361,11 @@ fn images_are_bit_identical_whatever_the_thread_count() {
     }
 }
 
-/// Rows rendered in order with one shared line of corners are the rows rendered alone,
-/// bit for bit, for two thirds of the corner rays; a line left by another row (here
-/// the row below) is not taken for this row's top corners.
+/// Rows rendered from corner lines traced beforehand are the rows rendered alone, bit
+/// for bit, for half the corner rays (each line traced once instead of twice); the
+/// rows' counts of supersampled pixels are what their renders report.
 #[test]
-fn rows_sharing_their_corners_are_the_rows() {
+fn rows_between_corner_lines_are_the_rows() {
     let (scene, settings) = small("two_balls.json", 40, 30);
     let buf = filled(&scene, &settings, 1);
     let store = buf.store::<64>(&settings).unwrap();
@@ -376,21 +376,31 @@ fn rows_sharing_their_corners_are_the_rows() {
             .unwrap()
             .with_splats(&[]); // the splats' caustics, which rows leave out
     let (w, h) = (40usize, 30u32);
-    let (mut alone, mut shared) = (RayCount::default(), RayCount::default());
-    let mut samples = vec![caustic::render::Sample::default(); w + 1];
-    let mut line = caustic::render::CornerLine::new(&mut samples);
-    for y in [5, 4].into_iter().chain(0..h) {
+    let mut lines = vec![vec![caustic::render::Sample::default(); w + 1]; h as usize + 1];
+    let mut traced = RayCount::default();
+    for (cy, line) in lines.iter_mut().enumerate() {
+        traced += r.corner_line(cy as u32, line);
+    }
+    let (mut alone, mut between) = (RayCount::default(), traced);
+    let mut supersampled = 0;
+    for y in 0..h {
         let (mut a, mut b) = (
             vec![PixelEstimate::default(); w],
             vec![PixelEstimate::default(); w],
         );
         alone += r.row(y, &mut a);
-        shared += r.row_sharing(y, &mut b, &mut line);
+        let (top, bottom) = (&lines[y as usize], &lines[y as usize + 1]);
+        let got = r.row_between(y, (top, bottom), &mut b);
         assert_eq!(a, b, "row {y}");
+        assert_eq!(got.refined, r.supersampled(top, bottom) as u64, "row {y}");
+        supersampled += got.refined;
+        between += got;
     }
-    // Each of the 30 rows in order after the first saves its 41 top corners (at least
-    // one eye ray each); rows 5 and 4 save nothing (row 5 left line 6, not line 4's).
-    assert!(alone.eye - shared.eye >= 29 * 41, "{shared:?} {alone:?}");
+    assert!(supersampled > 0);
+    // Rows alone trace every line but the first and last twice: 29 lines of 41
+    // corners, each at least one eye ray.
+    assert!(alone.eye - between.eye >= 29 * 41, "{between:?} {alone:?}");
+    assert_eq!((alone.refined, alone.shadow > 0), (between.refined, true));
 }
 
 /// Progressive passes too: the same seed gives the same bits on any number of threads.

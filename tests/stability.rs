@@ -12,7 +12,7 @@ mod support;
 
 use caustic::camera::Camera;
 use caustic::desktop::progress::Progress;
-use caustic::desktop::run::render_rows;
+use caustic::desktop::rows::render_rows;
 use caustic::desktop::{parse_scene, render, DesktopScene, RenderOptions};
 use caustic::desktop::{MAX_DEPTH, MAX_LIGHTS, MAX_OBJECTS};
 use caustic::geometry::{Hit, Ray, Shape};

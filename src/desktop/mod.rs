@@ -1,6 +1,6 @@
 //! The desktop side (feature `std`): scene files ([`scene_file`]) and the settings
 //! they share with the command line ([`settings`], one validation for both), images on
-//! disk ([`image`]: PNG, PFM, OpenEXR), threads and progress ([`run`]), and with
+//! disk ([`image`]: PNG, PFM, OpenEXR), threads and progress ([`run`], [`rows`]), and with
 //! feature `cli` the command-line arguments of `caustic` and the examples ([`cli`]).
 //!
 //! It is thin on purpose: everything that decides a pixel's value lives in the no_std
@@ -14,6 +14,7 @@ pub mod cli;
 pub mod image;
 pub mod photons;
 pub mod progress;
+pub mod rows;
 pub mod run;
 pub mod scene_file;
 pub mod settings;

@@ -7,7 +7,6 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use std::vec;
 
@@ -16,13 +15,12 @@ use serde::Serialize;
 use super::image::Image;
 use super::photons::{desktop_budget, PhotonBuffer};
 use super::progress::Progress;
+use super::rows::render_rows;
 use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::photon::{self, CausticStore, Footprint, Halves, Photon, PhotonSettings, SplatSums};
-use crate::render::{
-    CornerLine, ErrorTally, PixelEstimate, RayCount, Renderer, Sample, Sampling, REFINE,
-};
+use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
 use crate::Error;
 
 /// How to render on the desktop.
@@ -446,55 +444,6 @@ fn backward_pass<S: CausticStore + Sync>(
     stats.render_ms += ms(t.elapsed());
     stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
     Ok(frame)
-}
-
-/// Renders all rows of `frame` (`width` pixels each) on `threads` threads. Each takes
-/// the next free band of consecutive rows — eight, shrinking to one at the end so that
-/// the threads finish together — and renders it top to bottom, a row's bottom corners
-/// serving as the next row's top ones ([`Renderer::row_sharing`]).
-pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const D: usize>(
-    renderer: &Renderer<'_, S, O, L, D>,
-    frame: &mut [PixelEstimate],
-    width: usize,
-    threads: usize,
-    progress: &Progress,
-) -> RayCount {
-    let rows = Mutex::new(frame.chunks_mut(width.max(1)).enumerate());
-    let total = Mutex::new(RayCount::default());
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| {
-                let mut mine = RayCount::default();
-                let mut samples = vec![Sample::default(); width + 1];
-                loop {
-                    let band: vec::Vec<_> = match rows.lock() {
-                        Ok(mut r) => {
-                            // Eight rows, fewer in the last 128: the bands depend
-                            // on the image alone, so the rays traced do not depend
-                            // on the thread count (nor does the image, ever).
-                            let take = (r.len() / 16).clamp(1, 8);
-                            r.by_ref().take(take).collect()
-                        }
-                        Err(_) => break,
-                    };
-                    if band.is_empty() {
-                        break;
-                    }
-                    // A fresh line for each band: its first row traces its top
-                    // corners whichever band came before on this thread.
-                    let mut line = CornerLine::new(&mut samples);
-                    for (y, row) in band {
-                        mine += renderer.row_sharing(y as u32, row, &mut line);
-                        progress.tick();
-                    }
-                }
-                if let Ok(mut t) = total.lock() {
-                    *t += mine;
-                }
-            });
-        }
-    });
-    total.into_inner().unwrap_or_default()
 }
 
 /// Renders `scene` with Arvo's illumination maps (texels of side `texel_size` scene

@@ -78,8 +78,8 @@ mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{
-    CornerLine, RowPixel, Sampling, CAUSTIC_SHARE, CONTRAST, GRAZING, GRAZING_RAYS, REFINE,
-    REFINE_RAYS, REFINE_TOLERANCE, SIGNATURE_WEIGHT,
+    RowPixel, Sampling, CAUSTIC_SHARE, CONTRAST, GRAZING, GRAZING_RAYS, REFINE, REFINE_RAYS,
+    REFINE_TOLERANCE, SIGNATURE_WEIGHT,
 };
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].

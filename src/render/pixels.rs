@@ -456,13 +456,13 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     }
 
     /// Renders row `y` (0 = top) pixel by pixel, handing each estimate to `put`. With
-    /// a `line` of at least `width + 1` samples, the adaptive sampling takes the row's
-    /// top corners from it when it holds them and leaves the bottom ones in it.
+    /// `lines` of at least `width + 1` samples each, the adaptive sampling takes the
+    /// row's top and bottom corners from them instead of tracing them.
     fn row_with(
         &self,
         y: u32,
         width: usize,
-        line: Option<&mut CornerLine<'_>>,
+        lines: Option<(&[Sample], &[Sample])>,
         mut put: impl FnMut(usize, PixelEstimate),
     ) -> RayCount {
         let mut count = RayCount::default();
@@ -480,30 +480,21 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
                 }
             }
             Sampling::Adaptive(n) => {
-                let mut line = line.filter(|l| l.samples.len() > width);
-                let shared = line.as_ref().is_some_and(|l| l.line == Some(y));
-                // The top corner `x` when the line holds row y's.
-                let held = |line: &Option<&mut CornerLine<'_>>, x: usize| {
-                    line.as_ref().filter(|_| shared).map(|l| l.samples[x])
+                let lines = lines.filter(|(top, bottom)| top.len() > width && bottom.len() > width);
+                // Corner `cx` of the row's top or bottom line: given, or traced here.
+                let corner = |cx: usize, below: bool, count: &mut RayCount| match lines {
+                    Some((top, bottom)) => [top, bottom][below as usize][cx],
+                    None => self.corner(cx as u32, y + below as u32, count),
                 };
                 // Corners shared along the row: the left pair comes from the pixel before.
-                let mut top_left = held(&line, 0).unwrap_or_else(|| self.corner(0, y, &mut count));
-                let mut bottom_left = self.corner(0, y + 1, &mut count);
+                let mut top_left = corner(0, false, &mut count);
+                let mut bottom_left = corner(0, true, &mut count);
                 for x in 0..width {
-                    let top_right = held(&line, x + 1)
-                        .unwrap_or_else(|| self.corner(x as u32 + 1, y, &mut count));
-                    let bottom_right = self.corner(x as u32 + 1, y + 1, &mut count);
+                    let top_right = corner(x + 1, false, &mut count);
+                    let bottom_right = corner(x + 1, true, &mut count);
                     let c = [top_left, top_right, bottom_left, bottom_right];
                     put(x, self.adaptive(x as u32, y, n, &c, &mut count));
-                    if let Some(l) = line.as_mut() {
-                        // Slot x's top corner has been read: it takes the bottom one.
-                        l.samples[x] = bottom_left;
-                    }
                     (top_left, bottom_left) = (top_right, bottom_right);
-                }
-                if let Some(l) = line {
-                    l.samples[width] = bottom_left;
-                    l.line = Some(y + 1);
                 }
             }
         }
@@ -521,8 +512,7 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         c: &[Sample; 4],
         count: &mut RayCount,
     ) -> PixelEstimate {
-        let paths_differ = c.iter().any(|s| s.signature != c[0].signature);
-        let contrast = contrasted(c);
+        let (paths_differ, contrast) = disagree(c);
         if !paths_differ && !contrast {
             let mean = |f: fn(&Sample) -> Rgb| (f(&c[0]) + f(&c[1]) + f(&c[2]) + f(&c[3])) * 0.25;
             PixelEstimate {
@@ -546,19 +536,59 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
         self.row_with(y, row.len(), None, |x, p| row[x] = T::from_estimate(p))
     }
 
-    /// [`row`](Self::row), keeping the corner samples the adaptive sampling shares
-    /// between consecutive rows in `line`: rows rendered in order with one line trace
-    /// each line of corners once instead of twice. The same pixels, bit for bit (a
-    /// corner's sample depends on nothing but its position), and fewer rays.
-    pub fn row_sharing<T: RowPixel>(
+    /// Traces line `cy` of pixel corners (`0 ≤ cy ≤ H`, the top corners of row `cy`)
+    /// into `line[..=W]`: the samples that the adaptive sampling of row `cy − 1` and of
+    /// row `cy` both read ([`row_between`](Self::row_between)). A `line` shorter than
+    /// the width plus one is left alone.
+    pub fn corner_line(&self, cy: u32, line: &mut [Sample]) -> RayCount {
+        let mut count = RayCount::default();
+        let width = self.scene.camera().width() as usize;
+        if let Some(line) = line.get_mut(..=width) {
+            for (cx, s) in line.iter_mut().enumerate() {
+                *s = self.corner(cx as u32, cy, &mut count);
+            }
+        }
+        count
+    }
+
+    /// [`row`](Self::row) whose adaptive sampling takes its corners from the corner
+    /// lines `top` (line `y`) and `bottom` (line `y + 1`) that
+    /// [`corner_line`](Self::corner_line) traced: the same pixels, bit for bit (a
+    /// corner's sample depends on nothing but its position), with no corner traced
+    /// twice. Lines shorter than the width plus one are not used (the row traces its
+    /// own corners), and the other samplings do not read them.
+    pub fn row_between<T: RowPixel>(
         &self,
         y: u32,
+        lines: (&[Sample], &[Sample]),
         row: &mut [T],
-        line: &mut CornerLine<'_>,
     ) -> RayCount {
-        self.row_with(y, row.len(), Some(line), |x, p| {
+        self.row_with(y, row.len(), Some(lines), |x, p| {
             row[x] = T::from_estimate(p)
         })
+    }
+
+    /// Whether rows read corner lines: under [`Sampling::Adaptive`] only.
+    pub fn reads_corners(&self) -> bool {
+        matches!(self.sampling, Sampling::Adaptive(_))
+    }
+
+    /// The pixels between corner lines `top` and `bottom` whose corners disagree (by
+    /// path or by contrast), which the adaptive sampling supersamples: nearly all of a
+    /// row's cost, known before it is rendered. 0 under the other samplings.
+    pub fn supersampled(&self, top: &[Sample], bottom: &[Sample]) -> usize {
+        if !self.reads_corners() {
+            return 0;
+        }
+        let width = self.scene.camera().width() as usize;
+        top.windows(2)
+            .zip(bottom.windows(2))
+            .take(width)
+            .filter(|(t, b)| {
+                let (paths, contrast) = disagree(&[t[0], t[1], b[0], b[1]]);
+                paths || contrast
+            })
+            .count()
     }
 
     /// The row buffer cut to the image width; an error when it is shorter.
@@ -596,26 +626,6 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             sink(y, row).map_err(RowsError::Sink)?;
         }
         Ok(count)
-    }
-}
-
-/// The samples at one line of pixel corners, which the adaptive sampling of the row
-/// above and of the row below both need: see [`Renderer::row_sharing`].
-#[derive(Debug)]
-pub struct CornerLine<'a> {
-    /// The line of corners `samples` holds (`y` = the top corners of row `y`).
-    line: Option<u32>,
-    samples: &'a mut [Sample],
-}
-
-impl<'a> CornerLine<'a> {
-    /// An empty line over `samples`, which must hold at least the image width plus
-    /// one (a shorter one is not used).
-    pub fn new(samples: &'a mut [Sample]) -> Self {
-        Self {
-            line: None,
-            samples,
-        }
     }
 }
 
@@ -874,6 +884,13 @@ fn widen((lo, hi): (f32, f32), l: f32) -> (f32, f32) {
 
 /// `true` when the luminances of four corner samples differ by more than [`CONTRAST`]
 /// (Mitchell 1987's contrast) or one is NaN.
+/// Whether four corner samples disagree: their paths (signatures differ), and their
+/// luminances (see [`contrasted`]). Either sends the pixel to a grid.
+fn disagree(c: &[Sample; 4]) -> (bool, bool) {
+    let paths_differ = c.iter().any(|s| s.signature != c[0].signature);
+    (paths_differ, contrasted(c))
+}
+
 fn contrasted(c: &[Sample; 4]) -> bool {
     let (lo, hi) = c
         .iter()
