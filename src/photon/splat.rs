@@ -212,11 +212,12 @@ impl SplatSums {
         }
     }
 
-    /// Zero sums again, for a frame of `pixels` pixels (a new pass).
+    /// Zero sums again, for a frame of `pixels` pixels (a new pass): a fresh zeroed
+    /// allocation, whose pages the system zeroes as they are first written, rather than
+    /// 48 bytes a pixel written over before the pass (at 320×240, 900 pages faulted in
+    /// by one thread: 6 ms before the forward pass could start).
     pub fn clear(&mut self, pixels: usize) {
-        self.sums.clear();
-        self.sums.resize(pixels, [[0.0; 3]; 2]);
-        self.count = 0;
+        *self = Self::new(pixels);
     }
 
     /// Adds `splats`, in their order; one outside the frame is counted and dropped.
