@@ -158,7 +158,7 @@ fn pruned_eye_paths_stay_within_tolerance_of_the_full_tree() {
                 .with_ray_budget(budget)
                 .unwrap();
         let mut frame = vec![PixelEstimate::default(); 64 * 48];
-        let rays = render_rows(&r, &mut frame, 64, 2, &Progress::new(false, 48));
+        let rays = render_rows(&r, &mut frame, (64, None), 2, &Progress::new(false, 48));
         let mut img = caustic::desktop::Image::new(64, 48);
         for (p, f) in img.pixels.iter_mut().zip(&frame) {
             *p = f.radiance;

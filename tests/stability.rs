@@ -1112,7 +1112,7 @@ fn a_zero_power_light() {
         let r: Renderer<'_, _, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
             Renderer::new(sc, &NoCaustics, settings.max_depth()).unwrap();
         let mut frame = vec![PixelEstimate::default(); 16 * 12];
-        let rays = render_rows(&r, &mut frame, 16, 1, &Progress::new(false, 0));
+        let rays = render_rows(&r, &mut frame, (16, None), 1, &Progress::new(false, 0));
         let mut img = caustic::desktop::Image::new(16, 12);
         for (p, f) in img.pixels.iter_mut().zip(&frame) {
             *p = f.radiance;

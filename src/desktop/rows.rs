@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use std::vec;
 
 use super::progress::Progress;
-use crate::photon::CausticStore;
+use crate::photon::{CausticStore, SplatSums};
 use crate::render::{PixelEstimate, RayCount, Renderer, Sample};
 
 /// Most bytes of corner lines held at once: the whole image's up to about 200 000
@@ -27,11 +27,11 @@ use crate::render::{PixelEstimate, RayCount, Renderer, Sample};
 const CORNER_BYTES: usize = 8 << 20;
 
 /// Renders all rows of `frame` (`width` pixels each) on `threads` threads (see the
-/// module's notes).
+/// module's notes), each row taking its pixels' `splats` as it is finished.
 pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const D: usize>(
     renderer: &Renderer<'_, S, O, L, D>,
     frame: &mut [PixelEstimate],
-    width: usize,
+    (width, splats): (usize, Option<&SplatSums>),
     threads: usize,
     progress: &Progress,
 ) -> RayCount {
@@ -39,6 +39,13 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
     let mut rows: vec::Vec<Option<&mut [PixelEstimate]>> =
         frame.chunks_mut(width).map(Some).collect();
     let height = rows.len();
+    // A rendered row takes its splats.
+    let finish = |y: usize, row: &mut [PixelEstimate]| {
+        if let Some(splats) = splats {
+            splats.add_to_row(y as u32, row);
+        }
+        progress.tick();
+    };
     if !renderer.reads_corners() {
         let jobs = rows
             .iter_mut()
@@ -46,7 +53,7 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
             .filter_map(|(y, r)| Some((y, r.take()?)));
         return in_parallel(threads, jobs.collect(), |(y, row)| {
             let count = renderer.row(y as u32, row);
-            progress.tick();
+            finish(y, row);
             count
         });
     }
@@ -80,7 +87,7 @@ pub fn render_rows<S: CausticStore + Sync, const O: usize, const L: usize, const
         jobs.sort_by_key(|&(cost, i, _)| (core::cmp::Reverse(cost), i));
         total += in_parallel(threads, jobs, |(_, i, row)| {
             let count = renderer.row_between((y0 + i) as u32, (line(i), line(i + 1)), row);
-            progress.tick();
+            finish(y0 + i, row);
             count
         });
         lines.copy_within(n * line_len..(n + 1) * line_len, 0);

@@ -400,9 +400,8 @@ pub fn render_with_error(
 }
 
 /// The backward pass against one caustic store on `opts.threads` threads: a frame of
-/// pixel estimates, the splats (the caustics seen directly) added in emission order
-/// after its rows. Adds its time, its gather
-/// time and its rays to `stats`.
+/// pixel estimates, each row with the sums of its splats (the caustics seen directly)
+/// added once it is rendered. Adds its time, its gather time and its rays to `stats`.
 fn backward_pass<S: CausticStore + Sync>(
     scene: &DesktopScene,
     store: &S,
@@ -424,7 +423,7 @@ fn backward_pass<S: CausticStore + Sync>(
     }
     if splats.is_some() {
         // Only to say that the splats hold the caustics seen directly: the rows do not
-        // read them, and their sums are added to the frame below.
+        // read them, and `render_rows` adds their sums to each finished row.
         renderer = renderer.with_splats(&[]);
     }
     let cam = scene.camera();
@@ -433,14 +432,11 @@ fn backward_pass<S: CausticStore + Sync>(
     stats.rays += render_rows(
         &renderer,
         &mut frame,
-        cam.width() as usize,
+        (cam.width() as usize, splats),
         opts.threads.max(1),
         progress,
     );
-    if let Some(splats) = splats {
-        splats.add_to(&mut frame);
-        stats.photons_splatted += splats.count();
-    }
+    stats.photons_splatted += splats.map_or(0, SplatSums::count);
     stats.render_ms += ms(t.elapsed());
     stats.gather_cpu_ms += timed.nanos.load(Ordering::Relaxed) as f64 * 1e-6;
     Ok(frame)

@@ -241,8 +241,21 @@ impl SplatSums {
     /// Adds each pixel's sum, and its halves' difference, to `frame` (row-major, as
     /// many pixels as the sums; a pixel no splat reached is left alone).
     pub fn add_to<T: SplatTarget>(&self, frame: &mut [T]) {
+        self.add_to_pixels(0, frame);
+    }
+
+    /// [`add_to`](Self::add_to) for row `y` alone of a frame `row.len()` pixels wide:
+    /// the same pixels, so that rows rendered in parallel take their splats as they are
+    /// finished.
+    pub fn add_to_row<T: SplatTarget>(&self, y: u32, row: &mut [T]) {
+        self.add_to_pixels(y as usize * row.len(), row);
+    }
+
+    /// Adds the sums of pixels `first..` to `pixels`.
+    fn add_to_pixels<T: SplatTarget>(&self, first: usize, pixels: &mut [T]) {
+        let sums = self.sums.get(first..).unwrap_or_default();
         let rgb = |c: [f64; 3]| Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32);
-        for (px, [h0, h1]) in frame.iter_mut().zip(&self.sums) {
+        for (px, [h0, h1]) in pixels.iter_mut().zip(sums) {
             if h0 != &[0.0; 3] || h1 != &[0.0; 3] {
                 let total = rgb([0, 1, 2].map(|i| h0[i] + h1[i]));
                 px.add_sums(total, rgb([0, 1, 2].map(|i| h0[i] - h1[i])));
