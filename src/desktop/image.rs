@@ -125,20 +125,26 @@ impl Image {
 
     /// The pixels' bytes as 8-bit sRGB RGBA, tone mapped.
     pub fn to_rgba8(&self, tone: &ToneMap) -> Vec<u8> {
-        self.pixels
-            .iter()
-            .flat_map(|&c| {
-                let [r, g, b] = tone.srgb8(c);
-                [r, g, b, 255]
-            })
-            .collect()
+        let mut out = vec![0; self.pixels.len() * 4];
+        self.write_rgba8(tone, &mut out);
+        out
+    }
+
+    /// [`to_rgba8`](Self::to_rgba8) into `out`, four bytes a pixel (as many pixels as
+    /// both hold): no list built a byte at a time, as a `flat_map` would (2.6 ms of a
+    /// 320×240 PNG, perf).
+    fn write_rgba8(&self, tone: &ToneMap, out: &mut [u8]) {
+        for (px, &c) in out.chunks_exact_mut(4).zip(&self.pixels) {
+            let [r, g, b] = tone.srgb8(c);
+            px.copy_from_slice(&[r, g, b, 255]);
+        }
     }
 
     /// Writes an 8-bit sRGB PNG.
     pub fn write_png(&self, path: &Path, tone: &ToneMap) -> io::Result<()> {
         let mut pixmap = tiny_skia::Pixmap::new(self.width, self.height)
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "empty image"))?;
-        pixmap.data_mut().copy_from_slice(&self.to_rgba8(tone));
+        self.write_rgba8(tone, pixmap.data_mut());
         pixmap
             .save_png(path)
             .map_err(|e| io::Error::other(e.to_string()))
