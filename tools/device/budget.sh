@@ -40,8 +40,14 @@ eval "$(python3 "$here/profile.py" --summary-only "$elf" "$profile")"
 work=$((insns_photons + insns_render))
 
 kib() { awk -v b="$1" 'BEGIN { printf "%.1f KiB", b / 1024 }'; }
+# `check` runs inside `$(...)`, a subshell: it only prints. The status is decided below,
+# from the same comparisons (a `status=1` set inside it never reached the strict test).
+check() { if (( $1 <= $2 )); then echo "ok"; else echo "OVER"; fi; }
 status=0
-check() { if (( $1 <= $2 )); then echo "ok"; else echo "OVER"; status=1; fi; }
+for measured_bar in "$flash 49152" "$ram 65536" "$stack 4096" "$work 40000000"; do
+    read -r measured bar <<<"$measured_bar"
+    (( measured <= bar )) || status=1
+done
 
 echo "== budget of $elf"
 printf '%-44s %12s %10s  %-8s %s\n' "what" "measured" "" "bar" ""

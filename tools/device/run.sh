@@ -18,7 +18,8 @@
 #     hashes and printed error estimates (host == device bit for bit and digit for
 #     digit, and both == the committed values); the other firmwares' files and
 #     estimates must equal those byte for byte;
-#  6. prints each firmware's budget (budget.sh) and the Cortex-M4F instruction profile;
+#  6. prints each firmware's budget (budget.sh; Fig. 6 on the Cortex-M4F must meet its
+#     bars) and the Cortex-M4F instruction profile;
 #  7. ends with one JSON line per firmware:
 #     {"firmware","target","flash_bytes","static_ram_bytes","stack_bytes","photon_bytes",
 #      "forward_instructions","render_instructions","bit_identical"}.
@@ -183,7 +184,12 @@ for f in "${firmwares[@]}"; do
         && [[ "$(grep '^error_estimate' "$out/$name.log")" == "$(grep '^error_estimate' "$out/$first.log")" ]] \
         && identical=true
     step "$name: budget"
-    "$root/tools/device/budget.sh" "$elf" "$out/$name.log" "$out/$name.insn.txt" | tee "$out/$name.budget.txt"
+    # Issue 14's bars are Fig. 6's on the Cortex-M4F: missed there, the run fails (session
+    # 34's first corner lines went over two of them unnoticed; the others only report).
+    strict=0
+    [[ "$name" == cortex-m4f ]] && strict=1
+    CAUSTIC_BUDGET_STRICT=$strict "$root/tools/device/budget.sh" "$elf" "$out/$name.log" \
+        "$out/$name.insn.txt" | tee "$out/$name.budget.txt"
     eval "$(sed -n 's/^json_\([a-z_]*\)=\([0-9]*\)$/\1=\2/p' "$out/$name.budget.txt")"
     lines+=("$(printf '{"firmware": "%s", "target": "%s", "flash_bytes": %d, "static_ram_bytes": %d, "stack_bytes": %d, "photon_bytes": %d, "forward_instructions": %d, "render_instructions": %d, "bit_identical": %s}' \
         "$name" "$target" "$flash" "$ram" "$stack" "$photon_bytes" "$photons" "$render" "$identical")")
