@@ -186,22 +186,19 @@ fn longest_axis(photons: &[Photon]) -> usize {
 }
 
 /// The bounding box of the photons' positions, `(lo, hi)`; `lo = +∞`, `hi = −∞`
-/// without photons. Each bound moves only for a coordinate strictly beyond it, the
-/// comparison `minss`/`maxss` make, so the loop runs on whole vectors of coordinates:
-/// the same box as `min_num`/`max_num` (a photon's coordinates are finite, and an equal
-/// one of the other sign of zero leaves the bound as they do), without their NaN tests
-/// (the store's box over 2.1M photons took 6 ms on one thread between the balance and
-/// the eye pass).
+/// without photons. `Vec3::min`/`max` are IEEE minNum/maxNum, `min_num`/`max_num` for
+/// finite coordinates (an equal one of the other sign of zero may land either way; no
+/// test reads the box's sign of zero). About 2.7 ns a photon on the host whether the
+/// photons are in cache or not (5.6 ms for 2.1M; a strict comparison per coordinate
+/// measured the same, and executes 10% more instructions in the portable build).
 pub(crate) fn bounding_box(photons: &[Photon]) -> (Vec3, Vec3) {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in photons {
-        let q = p.position().to_array();
-        for i in 0..3 {
-            lo[i] = if q[i] < lo[i] { q[i] } else { lo[i] };
-            hi[i] = if q[i] > hi[i] { q[i] } else { hi[i] };
-        }
+        let q = p.position();
+        lo = lo.min(q);
+        hi = hi.max(q);
     }
-    (Vec3::from_array(lo), Vec3::from_array(hi))
+    (lo, hi)
 }
 
 /// One photon found by a query: its squared distance and index in the tree.
