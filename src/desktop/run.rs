@@ -494,10 +494,20 @@ pub fn render_illumination(
     stats.balance_ms += ms(t.elapsed());
     progress.tick();
     progress.phase(0, "rows", h as usize);
-    let mut sums = SplatSums::new((w * h) as usize);
-    sums.add(&splats);
-    let splats = settings.camera_splats().then_some(&sums);
-    let frame = backward_pass(scene, &maps, settings, splats, opts, &progress, &mut stats)?;
+    let sums = settings.camera_splats().then(|| {
+        let mut sums = SplatSums::new((w * h) as usize);
+        sums.add(&splats);
+        sums
+    });
+    let frame = backward_pass(
+        scene,
+        &maps,
+        settings,
+        sums.as_ref(),
+        opts,
+        &progress,
+        &mut stats,
+    )?;
     progress.finish();
     let mut sum = Passes::new(w as usize, frame.len());
     sum.add(&frame);
