@@ -886,8 +886,6 @@ fn widen((lo, hi): (f32, f32), l: f32) -> (f32, f32) {
     (crate::math::min_num(lo, l), crate::math::max(hi, l))
 }
 
-/// `true` when the luminances of four corner samples differ by more than [`CONTRAST`]
-/// (Mitchell 1987's contrast) or one is NaN.
 /// Whether four corner samples disagree: their paths (signatures differ), and their
 /// luminances (see [`contrasted`]). Either sends the pixel to a grid.
 fn disagree(c: &[Sample; 4]) -> (bool, bool) {
@@ -895,6 +893,8 @@ fn disagree(c: &[Sample; 4]) -> (bool, bool) {
     (paths_differ, contrasted(c))
 }
 
+/// `true` when the luminances of four corner samples differ by more than [`CONTRAST`]
+/// (Mitchell 1987's contrast) or one is NaN.
 fn contrasted(c: &[Sample; 4]) -> bool {
     let (lo, hi) = c
         .iter()

@@ -40,25 +40,25 @@ eval "$(python3 "$here/profile.py" --summary-only "$elf" "$profile")"
 work=$((insns_photons + insns_render))
 
 kib() { awk -v b="$1" 'BEGIN { printf "%.1f KiB", b / 1024 }'; }
-# `check` runs inside `$(...)`, a subshell: it only prints. The status is decided below,
-# from the same comparisons (a `status=1` set inside it never reached the strict test).
-check() { if (( $1 <= $2 )); then echo "ok"; else echo "OVER"; fi; }
+# `check MEASURED BAR` sets `verdict` and, when the bar is missed, `status`. Called in
+# this shell, never inside `$(...)`, whose subshell would drop `status`.
 status=0
-for measured_bar in "$flash 49152" "$ram 65536" "$stack 4096" "$work 40000000"; do
-    read -r measured bar <<<"$measured_bar"
-    (( measured <= bar )) || status=1
-done
+check() { if (( $1 <= $2 )); then verdict=ok; else verdict=OVER; status=1; fi; }
 
 echo "== budget of $elf"
 printf '%-44s %12s %10s  %-8s %s\n' "what" "measured" "" "bar" ""
-printf '%-44s %12d %10s  %-8s %s\n' "flash (.vector_table+.text+.rodata+.data)" "$flash" "$(kib "$flash")" "48 KiB" "$(check "$flash" 49152)"
+check "$flash" 49152
+printf '%-44s %12d %10s  %-8s %s\n' "flash (.vector_table+.text+.rodata+.data)" "$flash" "$(kib "$flash")" "48 KiB" "$verdict"
 printf '%-44s %12s\n' "  .vector_table / .text / .rodata" "$vt / $text / $rodata"
-printf '%-44s %12d %10s  %-8s %s\n' "static RAM (.data+.bss+.uninit)" "$ram" "$(kib "$ram")" "64 KiB" "$(check "$ram" 65536)"
+check "$ram" 65536
+printf '%-44s %12d %10s  %-8s %s\n' "static RAM (.data+.bss+.uninit)" "$ram" "$(kib "$ram")" "64 KiB" "$verdict"
 printf '%-44s %12d %10s\n' "  of which map, splats, row, path (statics)" "$map" "$(kib "$map")"
-printf '%-44s %12d %10s  %-8s %s\n' "stack high-water (measured)" "$stack" "$(kib "$stack")" "4 KiB" "$(check "$stack" 4096)"
+check "$stack" 4096
+printf '%-44s %12d %10s  %-8s %s\n' "stack high-water (measured)" "$stack" "$(kib "$stack")" "4 KiB" "$verdict"
 printf '%-44s %12d\n' "instructions, forward pass" "$insns_photons"
 printf '%-44s %12d\n' "instructions, render (160x120)" "$insns_render"
-printf '%-44s %12d %10s  %-8s %s\n' "instructions, forward + render" "$work" "" "40 M" "$(check "$work" 40000000)"
+check "$work" 40000000
+printf '%-44s %12d %10s  %-8s %s\n' "instructions, forward + render" "$work" "" "40 M" "$verdict"
 printf '%-44s %12d\n' "instructions, whole run" "$insns_total"
 echo "largest flash symbols:"
 "$nm" -S -C --size-sort "$elf" | awk '$3 ~ /^[tTrR]$/' | tail -6 |
