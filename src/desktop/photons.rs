@@ -14,13 +14,10 @@ use crate::error::within;
 use crate::math::Vec3;
 use crate::photon::{
     self, balance, photons_needed, Emitter, KdStore, KdTree, Photon, PhotonSettings, Splat,
-    SplatSums, Subtree,
+    SplatSums, Subtree, NO_BOX,
 };
 use crate::scene::Scene;
 use crate::Error;
-
-/// The bounding box of no photon.
-const EMPTY: (Vec3, Vec3) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
 
 /// The photon array of the forward pass, on the heap: allocated once for a budget and
 /// refilled in place by every progressive pass (fixed memory, Knaus & Zwicker 2011).
@@ -205,7 +202,7 @@ impl PhotonBuffer {
             unit: 0.0,
             splats: SplatSums::default(),
             coarse: [vec::Vec::new(), vec::Vec::new()],
-            bounds: EMPTY,
+            bounds: NO_BOX,
         })
     }
 
@@ -246,7 +243,7 @@ impl PhotonBuffer {
         self.splats
             .clear(camera.width() as usize * camera.height() as usize);
         self.coarse.iter_mut().for_each(vec::Vec::clear);
-        self.bounds = EMPTY;
+        self.bounds = NO_BOX;
         // The coarse levels: photons chosen by their emission index
         // (`Emitter::coarse_levels`), each standing for THINNING of the level before.
         // Only the footprint gathers behind glass read them, and those need the camera
@@ -272,7 +269,7 @@ impl PhotonBuffer {
                         photons: vec::Vec::with_capacity(CHUNK as usize),
                         splats: vec::Vec::new(),
                         coarse: [vec::Vec::new(), vec::Vec::new()],
-                        bounds: EMPTY,
+                        bounds: NO_BOX,
                     };
                     for i in start..end {
                         let landed = emitter.land(l, i, |x| {

@@ -31,6 +31,8 @@ pub use illumination::{
 #[cfg(feature = "std")]
 pub use illumination::{DEFAULT_HEAP_TEXELS, MAX_HEAP_TEXELS};
 pub(crate) use kdtree::bounding_box;
+#[cfg(feature = "std")]
+pub(crate) use kdtree::NO_BOX;
 pub use kdtree::{
     balance, balance_subtree, split_subtree, Found, KdTree, Neighbor, Subtree, BUCKET,
 };
