@@ -16,7 +16,7 @@ use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
 use caustic::photon;
 use caustic::photon::{NoCaustics, PhotonSettings};
-use caustic::render::{PixelEstimate, Sampling, REFINE};
+use caustic::render::{PixelEstimate, Sampling, REFINE, REFINE_FLOOR};
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
 use support::{add_floor, add_glass_sphere, add_light, scene_text};
@@ -809,18 +809,23 @@ fn the_program_writes_the_library_image_and_compares_it() {
 
 /// The eye-sampled luminance (the light-traced splats aside) of pixel `(x, y)` of scene
 /// `name` at 320×240 and 20k photons (seed 0), under each of `samplings`: the same
-/// photons for all.
+/// photons for all. The adaptive sampling refines as the desktop's does, above a floor
+/// of [`REFINE_FLOOR`] times the image's mean.
 fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f32; 3] {
     let (scene, settings) = small(name, 320, 240);
     let buf = filled(&scene, &settings, 0);
     let store = buf.store::<64>(&settings).unwrap();
     samplings.map(|sampling| {
-        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+        let mut r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
             Renderer::new(&scene, &store, settings.max_depth())
                 .unwrap()
                 .with_sampling(sampling)
                 .unwrap()
                 .with_splats(&[]); // the splats' caustics, which rows leave out
+        if r.reads_corners() {
+            let mean = r.mean_luminance(&mut RayCount::default());
+            r = r.with_refine_floor(REFINE_FLOOR * mean).unwrap();
+        }
         let mut row = vec![PixelEstimate::default(); 320];
         r.row(y, &mut row);
         row[x].radiance.luminance()
@@ -930,4 +935,101 @@ fn a_grazing_pixel_refines_until_two_grids_agree() {
 #[test]
 fn a_corner_no_sample_matches_refines_the_pixel() {
     adaptive_reaches_the_fine_grid("two_balls.json", (221, 150), [4, 32], [0.4, 0.05]);
+}
+
+/// The image's mean luminance comes from a lattice of corners that, on an image at most
+/// 32 pixels a side, is every corner once: the mean of all corner lines, bit for bit.
+/// On a larger image the lattice's mean stays within 10% of all corners' mean.
+#[test]
+fn the_mean_luminance_samples_the_whole_image() {
+    for (w, h, tolerance) in [(24, 17, 0.0), (32, 32, 0.0), (96, 72, 0.1)] {
+        let (scene, settings) = small("two_balls.json", w, h);
+        let buf = filled(&scene, &settings, 1);
+        let store = buf.store::<64>(&settings).unwrap();
+        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+            Renderer::new(&scene, &store, settings.max_depth())
+                .unwrap()
+                .with_sampling(Sampling::Adaptive(REFINE))
+                .unwrap()
+                .with_splats(&[]);
+        let mut line = vec![caustic::render::Sample::default(); w as usize + 1];
+        let (mut sum, mut traced) = (0.0f64, RayCount::default());
+        for cy in 0..=h {
+            traced += r.corner_line(cy, &mut line);
+            sum += line
+                .iter()
+                .map(|s| s.radiance.luminance() as f64)
+                .sum::<f64>();
+        }
+        let all = (sum / ((w + 1) * (h + 1)) as f64) as f32;
+        let mut rays = RayCount::default();
+        let lattice = r.mean_luminance(&mut rays);
+        assert!(all > 0.0, "{w}×{h}");
+        assert!(
+            (lattice - all).abs() <= tolerance * all,
+            "{w}×{h}: {lattice} {all}"
+        );
+        if tolerance == 0.0 {
+            assert_eq!(rays, traced, "{w}×{h}");
+        } else {
+            assert_eq!(rays.eye >= 33 * 33, rays.eye < traced.eye, "{rays:?}");
+        }
+    }
+}
+
+/// The refinement's floor changes only the pixels dimmer than it: a pixel whose
+/// brightest corner reaches the floor is the same bits with and without it, the dimmer
+/// ones stop refining sooner (fewer eye rays), and an infinite floor stops every pixel
+/// at its first grid (fewer still). A negative or NaN floor is refused.
+#[test]
+fn the_refine_floor_spares_only_dim_pixels() {
+    let (scene, settings) = small("two_balls.json", 64, 48);
+    let buf = filled(&scene, &settings, 2);
+    let store = buf.store::<64>(&settings).unwrap();
+    let adaptive = || -> Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> {
+        Renderer::new(&scene, &store, settings.max_depth())
+            .unwrap()
+            .with_sampling(Sampling::Adaptive(REFINE))
+            .unwrap()
+            .with_splats(&[])
+    };
+    let plain = adaptive();
+    let floor = REFINE_FLOOR * plain.mean_luminance(&mut RayCount::default());
+    let render = |f: f32| {
+        let r = adaptive().with_refine_floor(f).unwrap();
+        let mut img = vec![PixelEstimate::default(); 64 * 48];
+        let mut rays = RayCount::default();
+        for (y, row) in img.chunks_mut(64).enumerate() {
+            rays += r.row(y as u32, row);
+        }
+        (img, rays)
+    };
+    let ((a, ra), (b, rb), (_, rc)) = (render(0.0), render(floor), render(f32::INFINITY));
+    let mut line = vec![caustic::render::Sample::default(); 65];
+    let corners: Vec<Vec<f32>> = (0..=48)
+        .map(|cy| {
+            plain.corner_line(cy, &mut line);
+            line.iter().map(|s| s.radiance.luminance()).collect()
+        })
+        .collect();
+    let (mut same, mut dim_changed) = (0, 0);
+    for (i, (pa, pb)) in a.iter().zip(&b).enumerate() {
+        let (x, y) = (i % 64, i / 64);
+        let bright = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+            .map(|(cx, cy)| corners[cy][cx])
+            .into_iter()
+            .fold(0.0, f32::max);
+        if bright >= floor {
+            assert_eq!(pa, pb, "pixel ({x}, {y})");
+            same += 1;
+        } else if pa != pb {
+            dim_changed += 1;
+        }
+    }
+    assert!(same > 0 && dim_changed > 0, "{same} {dim_changed}");
+    assert_eq!((ra.refined, rb.refined), (rc.refined, rc.refined));
+    assert!(rc.eye < rb.eye && rb.eye < ra.eye, "{ra:?} {rb:?} {rc:?}");
+    for bad in [-1.0, f32::NAN] {
+        assert!(adaptive().with_refine_floor(bad).is_err(), "{bad}");
+    }
 }

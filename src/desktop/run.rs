@@ -20,7 +20,9 @@ use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::photon::{self, CausticStore, Footprint, Halves, Photon, PhotonSettings, SplatSums};
-use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
+use crate::render::{
+    ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE, REFINE_FLOOR,
+};
 use crate::Error;
 
 /// How to render on the desktop.
@@ -430,9 +432,14 @@ fn backward_pass<S: CausticStore + Sync>(
         // read them, and `render_rows` adds their sums to each finished row.
         renderer = renderer.with_splats(&[]);
     }
+    let t = Instant::now();
+    if renderer.reads_corners() {
+        // A dim pixel's refinement stops at 1% of twice the image's mean.
+        let mean = renderer.mean_luminance(&mut stats.rays);
+        renderer = renderer.with_refine_floor(REFINE_FLOOR * mean)?;
+    }
     let cam = scene.camera();
     let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
-    let t = Instant::now();
     stats.rays += render_rows(
         &renderer,
         &mut frame,

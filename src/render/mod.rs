@@ -78,8 +78,8 @@ mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{
-    RowPixel, Sampling, CAUSTIC_SHARE, CONTRAST, GRAZING, GRAZING_RAYS, REFINE, REFINE_RAYS,
-    REFINE_TOLERANCE, SIGNATURE_WEIGHT,
+    RowPixel, Sampling, CAUSTIC_SHARE, CONTRAST, GRAZING, GRAZING_RAYS, LATTICE, REFINE,
+    REFINE_FLOOR, REFINE_RAYS, REFINE_TOLERANCE, SIGNATURE_WEIGHT,
 };
 
 /// The default cut-off of branch throughput: see [`Renderer::with_cutoff`].
@@ -266,6 +266,9 @@ pub struct Renderer<'a, S, const OBJECTS: usize, const LIGHTS: usize, const DEPT
     pub(super) ray_budget: u32,
     /// Rays one eye ray may cost: itself and one shadow ray per lit light.
     rays_per_hit: u32,
+    /// The luminance below which a pixel's brightness does not lower its refinement's
+    /// tolerance ([`Renderer::with_refine_floor`]).
+    floor: f32,
 }
 
 impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
@@ -292,6 +295,7 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             cutoff: DEFAULT_CUTOFF,
             ray_budget: DEFAULT_RAY_BUDGET,
             rays_per_hit: 1 + lit.count() as u32,
+            floor: 0.0,
         })
     }
 
@@ -329,6 +333,25 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     pub fn with_splats(mut self, splats: &'a [Splat]) -> Self {
         self.splats = Some(splats);
         self
+    }
+
+    /// Under [`Sampling::Adaptive`], a supersampled pixel is refined while its error
+    /// estimate exceeds [`REFINE_TOLERANCE`] of the brightest of its value, its
+    /// corners and `floor` (a luminance; default 0, the pixel's own brightness alone).
+    /// The desktop sets [`REFINE_FLOOR`] times [`mean_luminance`](Self::mean_luminance).
+    /// An error for a negative or NaN `floor`; `+∞` stops every refinement after the
+    /// first grid.
+    pub fn with_refine_floor(mut self, floor: f32) -> Result<Self, Error> {
+        if floor.is_nan() || floor < 0.0 {
+            return Err(Error::OutOfRange {
+                what: "refine floor",
+                value: floor,
+                min: 0.0,
+                max: f32::INFINITY,
+            });
+        }
+        self.floor = floor;
+        Ok(self)
     }
 
     /// How pixels are sampled; an error for a grid side outside `1..=64`.
