@@ -434,9 +434,12 @@ fn backward_pass<S: CausticStore + Sync>(
     }
     let t = Instant::now();
     if renderer.reads_corners() {
-        // A dim pixel's refinement stops at 1% of twice the image's mean.
+        // A dim pixel's refinement stops at 1% of twice the image's mean (none if the
+        // samples are not numbers: their pixels say so without a refused render).
         let mean = renderer.mean_luminance(&mut stats.rays);
-        renderer = renderer.with_refine_floor(REFINE_FLOOR * mean)?;
+        if !mean.is_nan() {
+            renderer = renderer.with_refine_floor(REFINE_FLOOR * mean)?;
+        }
     }
     let cam = scene.camera();
     let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
