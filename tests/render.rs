@@ -15,7 +15,7 @@ use caustic::material::Classic;
 use caustic::material::{interface, Material};
 use caustic::math::{reflect, Rgb, UnitVec3, Vec3};
 use caustic::photon;
-use caustic::photon::{NoCaustics, PhotonSettings};
+use caustic::photon::{CausticStore, NoCaustics, PhotonSettings};
 use caustic::render::{PixelEstimate, Sampling, REFINE, REFINE_FLOOR};
 use caustic::render::{RayCount, Renderer, RowsError, DEFAULT_CUTOFF, DEFAULT_RAY_BUDGET};
 use caustic::scene::Scene;
@@ -317,6 +317,20 @@ fn filled(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> PhotonB
     buf
 }
 
+/// The desktop's eye pass over `store`: the adaptive sampling, with the splats'
+/// caustics left out of the rows (the desktop adds their sums to each finished row).
+fn adaptive<'a, S: CausticStore>(
+    scene: &'a DesktopScene,
+    store: &'a S,
+    settings: &PhotonSettings,
+) -> Renderer<'a, S, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> {
+    Renderer::new(scene, store, settings.max_depth())
+        .unwrap()
+        .with_sampling(Sampling::Adaptive(REFINE))
+        .unwrap()
+        .with_splats(&[])
+}
+
 fn bits(img: &caustic::desktop::Image) -> Vec<[u32; 3]> {
     img.pixels
         .iter()
@@ -369,12 +383,7 @@ fn rows_between_corner_lines_are_the_rows() {
     let (scene, settings) = small("two_balls.json", 40, 30);
     let buf = filled(&scene, &settings, 1);
     let store = buf.store::<64>(&settings).unwrap();
-    let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
-        Renderer::new(&scene, &store, settings.max_depth())
-            .unwrap()
-            .with_sampling(Sampling::Adaptive(REFINE))
-            .unwrap()
-            .with_splats(&[]); // the splats' caustics, which rows leave out
+    let r = adaptive(&scene, &store, &settings);
     let (w, h) = (40usize, 30u32);
     let mut lines = vec![vec![caustic::render::Sample::default(); w + 1]; h as usize + 1];
     let mut traced = RayCount::default();
@@ -946,12 +955,7 @@ fn the_mean_luminance_samples_the_whole_image() {
         let (scene, settings) = small("two_balls.json", w, h);
         let buf = filled(&scene, &settings, 1);
         let store = buf.store::<64>(&settings).unwrap();
-        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
-            Renderer::new(&scene, &store, settings.max_depth())
-                .unwrap()
-                .with_sampling(Sampling::Adaptive(REFINE))
-                .unwrap()
-                .with_splats(&[]);
+        let r = adaptive(&scene, &store, &settings);
         let mut line = vec![caustic::render::Sample::default(); w as usize + 1];
         let (mut sum, mut traced) = (0.0f64, RayCount::default());
         for cy in 0..=h {
@@ -986,13 +990,7 @@ fn the_refine_floor_spares_only_dim_pixels() {
     let (scene, settings) = small("two_balls.json", 64, 48);
     let buf = filled(&scene, &settings, 2);
     let store = buf.store::<64>(&settings).unwrap();
-    let adaptive = || -> Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> {
-        Renderer::new(&scene, &store, settings.max_depth())
-            .unwrap()
-            .with_sampling(Sampling::Adaptive(REFINE))
-            .unwrap()
-            .with_splats(&[])
-    };
+    let adaptive = || adaptive(&scene, &store, &settings);
     let plain = adaptive();
     let floor = REFINE_FLOOR * plain.mean_luminance(&mut RayCount::default());
     let render = |f: f32| {
