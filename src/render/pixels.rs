@@ -66,7 +66,11 @@ pub const REFINE_TOLERANCE: f32 = 0.01;
 /// 1.54M, 1.44M, 1.31M, 1.25M; the tube's 0.0285 0.0267 0.0287 0.0284 went to
 /// 0.0285 0.0267 0.0288 0.0284 (1), 0.0288 0.0269 0.0289 0.0285 (2), 0.0290 0.0273
 /// 0.0291 0.0288 (3) and 0.0293 0.0274 0.0290 0.0287 (4) with its eye rays 1.83M →
-/// 1.51M, 1.18M, 0.97M, 0.86M.
+/// 1.51M, 1.18M, 0.97M, 0.86M (medians of the seeds; `docs/accuracy.md`, session 37).
+/// A grazing pixel ([`GRAZING`]) keeps its own brightness: its grids' halves alias a
+/// sliver of focus alike, so its error estimate cannot vouch for a coarse grid (with
+/// the floor, the sphere + wall's (143, 148), a focus seen through the ball's rim,
+/// read 0.0313 against its 64×64 grid's 0.0280).
 pub const REFINE_FLOOR: f32 = 2.0;
 
 /// Corners along each side of the lattice whose samples estimate the image's mean
