@@ -825,16 +825,14 @@ fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f
     let buf = filled(&scene, &settings, 0);
     let store = buf.store::<64>(&settings).unwrap();
     samplings.map(|sampling| {
-        let mut r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
+        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
             Renderer::new(&scene, &store, settings.max_depth())
                 .unwrap()
                 .with_sampling(sampling)
                 .unwrap()
-                .with_splats(&[]); // the splats' caustics, which rows leave out
-        if r.reads_corners() {
-            let mean = r.mean_luminance(&mut RayCount::default());
-            r = r.with_refine_floor(REFINE_FLOOR * mean).unwrap();
-        }
+                .with_splats(&[]) // the splats' caustics, which rows leave out
+                .with_image_floor(&mut RayCount::default())
+                .unwrap();
         let mut row = vec![PixelEstimate::default(); 320];
         r.row(y, &mut row);
         row[x].radiance.luminance()

@@ -20,9 +20,7 @@ use super::{DesktopScene, MAX_DEPTH, MAX_GATHER};
 use crate::material::Classic;
 use crate::math::{Rgb, UnitVec3, Vec3};
 use crate::photon::{self, CausticStore, Footprint, Halves, Photon, PhotonSettings, SplatSums};
-use crate::render::{
-    ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE, REFINE_FLOOR,
-};
+use crate::render::{ErrorTally, PixelEstimate, RayCount, Renderer, Sampling, REFINE};
 use crate::Error;
 
 /// How to render on the desktop.
@@ -433,14 +431,8 @@ fn backward_pass<S: CausticStore + Sync>(
         renderer = renderer.with_splats(&[]);
     }
     let t = Instant::now();
-    if renderer.reads_corners() {
-        // A dim pixel's refinement stops at 1% of twice the image's mean (none if the
-        // samples are not numbers: their pixels say so without a refused render).
-        let mean = renderer.mean_luminance(&mut stats.rays);
-        if !mean.is_nan() {
-            renderer = renderer.with_refine_floor(REFINE_FLOOR * mean)?;
-        }
-    }
+    // A dim pixel's refinement stops at 1% of twice the image's mean.
+    renderer = renderer.with_image_floor(&mut stats.rays)?;
     let cam = scene.camera();
     let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
     stats.rays += render_rows(

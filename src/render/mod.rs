@@ -338,8 +338,8 @@ impl<'a, S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
     /// Under [`Sampling::Adaptive`], a supersampled pixel is refined while its error
     /// estimate exceeds [`REFINE_TOLERANCE`] of the brightest of its value, its
     /// corners and `floor` (a luminance; default 0, the pixel's own brightness alone);
-    /// a grazing pixel keeps its own (see [`REFINE_FLOOR`]). The desktop sets
-    /// [`REFINE_FLOOR`] times [`mean_luminance`](Self::mean_luminance).
+    /// a grazing pixel keeps its own (see [`REFINE_FLOOR`]). The desktop's is
+    /// [`with_image_floor`](Self::with_image_floor).
     /// An error for a negative or NaN `floor`; `+∞` stops every refinement after the
     /// first grid.
     pub fn with_refine_floor(mut self, floor: f32) -> Result<Self, Error> {

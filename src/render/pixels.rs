@@ -56,7 +56,7 @@ pub const REFINE_TOLERANCE: f32 = 0.01;
 
 /// The floor under a pixel's brightness in [`REFINE_TOLERANCE`], as a multiple of the
 /// image's mean luminance ([`Renderer::mean_luminance`], set with
-/// [`Renderer::with_refine_floor`]). A pixel's error counts in the image's relative
+/// [`Renderer::with_image_floor`]). A pixel's error counts in the image's relative
 /// RMSE by its absolute size, so a dim pixel need not be refined to 1% of its own
 /// value: its tolerance is 1% of at least this many means. Chosen on the tuning scenes
 /// at 1.6M photons a light (four seeds; plain photons blocks), as the largest floor
@@ -621,6 +621,23 @@ impl<S: CausticStore, const O: usize, const L: usize, const DEPTH: usize>
             }
         }
         (sum / n.max(1) as f64) as f32
+    }
+
+    /// The desktop's floor: under [`Sampling::Adaptive`],
+    /// [`with_refine_floor`](Self::with_refine_floor) at [`REFINE_FLOOR`] times the
+    /// image's [`mean_luminance`](Self::mean_luminance), whose samples are counted in
+    /// `count`; none when the mean is not a number (a NaN sample: its pixels say so
+    /// without a refused render). The other samplings refine nothing and trace nothing
+    /// here.
+    pub fn with_image_floor(self, count: &mut RayCount) -> Result<Self, Error> {
+        if !self.reads_corners() {
+            return Ok(self);
+        }
+        let mean = self.mean_luminance(count);
+        if mean.is_nan() {
+            return Ok(self);
+        }
+        self.with_refine_floor(REFINE_FLOOR * mean)
     }
 
     /// Whether rows read corner lines: under [`Sampling::Adaptive`] only.
