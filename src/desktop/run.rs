@@ -431,7 +431,7 @@ fn backward_pass<S: CausticStore + Sync>(
         renderer = renderer.with_splats(&[]);
     }
     let t = Instant::now();
-    // A dim pixel's refinement stops at 1% of twice the image's mean.
+    // A dim pixel's refinement stops at 1% of REFINE_FLOOR times the image's mean.
     renderer = renderer.with_image_floor(&mut stats.rays)?;
     let cam = scene.camera();
     let mut frame = vec![PixelEstimate::default(); cam.width() as usize * cam.height() as usize];
