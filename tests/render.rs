@@ -317,18 +317,28 @@ fn filled(scene: &DesktopScene, settings: &PhotonSettings, seed: u64) -> PhotonB
     buf
 }
 
-/// The desktop's eye pass over `store`: the adaptive sampling, with the splats'
-/// caustics left out of the rows (the desktop adds their sums to each finished row).
+/// The desktop's eye pass over `store` under `sampling`, with the splats' caustics
+/// left out of the rows (the desktop adds their sums to each finished row).
+fn eye_pass<'a, S: CausticStore>(
+    scene: &'a DesktopScene,
+    store: &'a S,
+    settings: &PhotonSettings,
+    sampling: Sampling,
+) -> Renderer<'a, S, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> {
+    Renderer::new(scene, store, settings.max_depth())
+        .unwrap()
+        .with_sampling(sampling)
+        .unwrap()
+        .with_splats(&[])
+}
+
+/// [`eye_pass`] under the desktop's adaptive sampling.
 fn adaptive<'a, S: CausticStore>(
     scene: &'a DesktopScene,
     store: &'a S,
     settings: &PhotonSettings,
 ) -> Renderer<'a, S, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> {
-    Renderer::new(scene, store, settings.max_depth())
-        .unwrap()
-        .with_sampling(Sampling::Adaptive(REFINE))
-        .unwrap()
-        .with_splats(&[])
+    eye_pass(scene, store, settings, Sampling::Adaptive(REFINE))
 }
 
 fn bits(img: &caustic::desktop::Image) -> Vec<[u32; 3]> {
@@ -825,14 +835,9 @@ fn pixel_under(name: &str, (x, y): (usize, u32), samplings: [Sampling; 3]) -> [f
     let buf = filled(&scene, &settings, 0);
     let store = buf.store::<64>(&settings).unwrap();
     samplings.map(|sampling| {
-        let r: Renderer<_, MAX_OBJECTS, MAX_LIGHTS, MAX_DEPTH> =
-            Renderer::new(&scene, &store, settings.max_depth())
-                .unwrap()
-                .with_sampling(sampling)
-                .unwrap()
-                .with_splats(&[]) // the splats' caustics, which rows leave out
-                .with_image_floor(&mut RayCount::default())
-                .unwrap();
+        let r = eye_pass(&scene, &store, &settings, sampling)
+            .with_image_floor(&mut RayCount::default())
+            .unwrap();
         let mut row = vec![PixelEstimate::default(); 320];
         r.row(y, &mut row);
         row[x].radiance.luminance()
@@ -988,11 +993,11 @@ fn the_refine_floor_spares_only_dim_pixels() {
     let (scene, settings) = small("two_balls.json", 64, 48);
     let buf = filled(&scene, &settings, 2);
     let store = buf.store::<64>(&settings).unwrap();
-    let adaptive = || adaptive(&scene, &store, &settings);
-    let plain = adaptive();
+    let fresh = || adaptive(&scene, &store, &settings);
+    let plain = fresh();
     let floor = REFINE_FLOOR * plain.mean_luminance(&mut RayCount::default());
     let render = |f: f32| {
-        let r = adaptive().with_refine_floor(f).unwrap();
+        let r = fresh().with_refine_floor(f).unwrap();
         let mut img = vec![PixelEstimate::default(); 64 * 48];
         let mut rays = RayCount::default();
         for (y, row) in img.chunks_mut(64).enumerate() {
@@ -1026,6 +1031,6 @@ fn the_refine_floor_spares_only_dim_pixels() {
     assert_eq!((ra.refined, rb.refined), (rc.refined, rc.refined));
     assert!(rc.eye < rb.eye && rb.eye < ra.eye, "{ra:?} {rb:?} {rc:?}");
     for bad in [-1.0, f32::NAN] {
-        assert!(adaptive().with_refine_floor(bad).is_err(), "{bad}");
+        assert!(fresh().with_refine_floor(bad).is_err(), "{bad}");
     }
 }
