@@ -371,6 +371,38 @@ fn the_parallel_forward_pass_is_the_serial_one() {
     }
 }
 
+/// A range of photons landed together (each half's directions worked out eight at a
+/// time) leaves what each photon landed alone leaves, in the same order: from an odd
+/// start, across the two halves, to an end that is not a whole batch, on both lights
+/// of a scene whose cones overlap (glass balls, a mirror box and a tube).
+#[test]
+fn landing_a_range_is_landing_each_photon() {
+    let text = scene_text("heldout/balls_mirror_tube.json");
+    let scene = parse_scene(&text).unwrap().scene;
+    let s = PhotonSettings::new(50_000, 16, 0.1, 8).unwrap();
+    let emitter = photon::Emitter::new(&scene, &s, 5, 0);
+    for l in 0..scene.lights().len() {
+        let mut together = Vec::new();
+        emitter
+            .land_range(l, 7..3001, |i, x| {
+                together.push((i, x));
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+        let mut alone = Vec::new();
+        for i in 7..3001 {
+            emitter
+                .land(l, i, |x| {
+                    alone.push((i, x));
+                    Ok::<(), ()>(())
+                })
+                .unwrap();
+        }
+        assert!(alone.len() > 1500, "{}", alone.len());
+        assert_eq!(together, alone, "light {l}");
+    }
+}
+
 /// A far, sun-like light sends as much power through a glass tube and a glass box as
 /// the same light fifty times nearer (each at intensity `∝ d²`, so the irradiance it
 /// brings is the same and its photons arrive nearly parallel): from 10⁴ units the

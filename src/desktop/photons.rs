@@ -271,24 +271,22 @@ impl PhotonBuffer {
                         coarse: [vec::Vec::new(), vec::Vec::new()],
                         bounds: NO_BOX,
                     };
-                    for i in start..end {
-                        let landed = emitter.land(l, i, |x| {
-                            if let Some(p) = x.photon {
-                                chunk.photons.push(p);
-                                let levels = if coarse {
-                                    emitter.coarse_levels(l, i)
-                                } else {
-                                    0
-                                };
-                                for level in &mut chunk.coarse[..levels] {
-                                    level.push(p);
-                                }
+                    let landed = emitter.land_range(l, start..end, |i, x| {
+                        if let Some(p) = x.photon {
+                            chunk.photons.push(p);
+                            let levels = if coarse {
+                                emitter.coarse_levels(l, i)
+                            } else {
+                                0
+                            };
+                            for level in &mut chunk.coarse[..levels] {
+                                level.push(p);
                             }
-                            chunk.splats.extend(x.splat);
-                            Ok::<(), core::convert::Infallible>(())
-                        });
-                        let Ok(()) = landed;
-                    }
+                        }
+                        chunk.splats.extend(x.splat);
+                        Ok::<(), core::convert::Infallible>(())
+                    });
+                    let Ok(()) = landed;
                     // Read while the chunk's photons are in this core's cache.
                     chunk.bounds = photon::bounding_box(&chunk.photons);
                     if let Ok(mut order) = order.lock() {

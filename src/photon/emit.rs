@@ -239,37 +239,98 @@ impl<const OBJECTS: usize> Emission<OBJECTS> {
         index: u32,
         shift: (f32, f32),
     ) -> (UnitVec3, Rgb, u32, usize) {
-        match self {
+        let [p] = self.photons::<1>(light, index, shift);
+        p
+    }
+
+    /// Photons `first..first + N` of the plan, as [`photon`](Self::photon) gives each
+    /// (an index past [`count`](Self::count) gives a photon no caller reads), worked
+    /// out a step at a time for all `N`. One photon's direction is a chain of
+    /// dependent divisions and square roots (the point's coordinate over the cone's
+    /// count, `sin θ`, the normalising length and its reciprocal) that a core mostly
+    /// waits on; in steps over eight photons the chains overlap (the desktop's
+    /// [`Emitter::land_range`](super::Emitter::land_range)). Each lane does the same
+    /// IEEE-754 operations in the same order whatever `N`: the same photons, bit for
+    /// bit.
+    pub(crate) fn photons<const N: usize>(
+        &self,
+        light: &PointLight,
+        first: u32,
+        shift: (f32, f32),
+    ) -> [(UnitVec3, Rgb, u32, usize); N] {
+        let cones = match self {
             Emission::Sphere { count } => {
-                let (s, t) = hammersley(index, *count, shift);
-                let (sin_u, cos_u) = crate::math::sin_cos_turns(s);
-                let sin_v = 2.0 * t - 1.0;
-                let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
-                let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
-                let power = light.intensity() * (4.0 * PI / *count as f32);
-                (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power, index, 0)
+                return core::array::from_fn(|k| {
+                    let index = first.wrapping_add(k as u32);
+                    let (dir, power) = sphere(light, index, *count, shift);
+                    (dir, power, index, 0)
+                });
             }
-            Emission::Cones(cones) => {
-                let (local, which) = self.local(index);
-                let c = &cones[which];
-                let (s, t) = hammersley(local, c.count, shift);
-                let om = s * c.one_minus_cos; // 1 − cos θ
-                let cos_t = 1.0 - om;
-                let sin_t = crate::math::sqrt(crate::math::max_num(om * (2.0 - om), 0.0));
-                let (sin_p, cos_p) = crate::math::sin_cos_turns(t);
-                let d = c.axis.get() * cos_t + (c.e1.get() * cos_p + c.e2.get() * sin_p) * sin_t;
-                let dir = UnitVec3::new(d).unwrap_or(c.axis);
-                let density: f32 = cones
-                    .iter()
-                    .enumerate()
-                    .filter(|&(j, o)| j == which || o.contains(dir))
-                    .map(|(_, o)| o.density)
-                    .sum();
-                (dir, light.intensity() * (1.0 / density), local, which)
+            Emission::Cones(cones) => cones,
+        };
+        let (mut local, mut which) = ([0u32; N], [0usize; N]);
+        for k in 0..N {
+            (local[k], which[k]) = self.local(first.wrapping_add(k as u32));
+        }
+        let (mut s, mut t) = ([0.0f32; N], [0.0f32; N]);
+        for k in 0..N {
+            (s[k], t[k]) = hammersley(local[k], cones[which[k]].count, shift);
+        }
+        let (mut cos_t, mut sin2_t) = ([0.0f32; N], [0.0f32; N]);
+        for k in 0..N {
+            let om = s[k] * cones[which[k]].one_minus_cos; // 1 − cos θ
+            cos_t[k] = 1.0 - om;
+            sin2_t[k] = crate::math::max_num(om * (2.0 - om), 0.0);
+        }
+        let mut sin_t = [0.0f32; N];
+        for k in 0..N {
+            sin_t[k] = crate::math::sqrt(sin2_t[k]);
+        }
+        let (mut sin_p, mut cos_p) = ([0.0f32; N], [0.0f32; N]);
+        for k in 0..N {
+            (sin_p[k], cos_p[k]) = crate::math::sin_cos_turns(t[k]);
+        }
+        let mut d = [Vec3::ZERO; N];
+        for k in 0..N {
+            let c = &cones[which[k]];
+            d[k] = c.axis.get() * cos_t[k]
+                + (c.e1.get() * cos_p[k] + c.e2.get() * sin_p[k]) * sin_t[k];
+        }
+        let mut dir = [UnitVec3::Z; N];
+        for k in 0..N {
+            dir[k] = UnitVec3::new(d[k]).unwrap_or(cones[which[k]].axis);
+        }
+        // The density: the sum over the cones that hold the direction, in their order
+        // (from `-0.0`, as `Iterator::sum` starts).
+        let mut density = [-0.0f32; N];
+        for (j, o) in cones.iter().enumerate() {
+            for k in 0..N {
+                if which[k] == j || o.contains(dir[k]) {
+                    density[k] += o.density;
+                }
             }
         }
+        core::array::from_fn(|k| {
+            let power = light.intensity() * (1.0 / density[k]);
+            (dir[k], power, local[k], which[k])
+        })
     }
 }
+
+/// Photon `index` of `count` over the whole sphere: its direction and power.
+fn sphere(light: &PointLight, index: u32, count: u32, shift: (f32, f32)) -> (UnitVec3, Rgb) {
+    let (s, t) = hammersley(index, count, shift);
+    let (sin_u, cos_u) = crate::math::sin_cos_turns(s);
+    let sin_v = 2.0 * t - 1.0;
+    let cos_v = crate::math::sqrt(crate::math::max_num(1.0 - sin_v * sin_v, 0.0));
+    let d = Vec3::new(cos_v * cos_u, cos_v * sin_u, sin_v);
+    let power = light.intensity() * (4.0 * PI / count as f32);
+    (UnitVec3::new(d).unwrap_or(UnitVec3::Z), power)
+}
+
+/// Photons the desktop's forward pass works out together ([`Emission::photons`]).
+#[cfg(feature = "std")]
+pub(crate) const LANES: usize = 8;
 
 #[cfg(test)]
 mod tests {
@@ -340,6 +401,39 @@ mod tests {
             (flux - union).abs() / union < 0.01,
             "flux {flux} vs union solid angle {union}"
         );
+    }
+
+    /// The batch gives every photon `photon` gives, bit for bit: across the cones'
+    /// boundaries, where cones overlap, and for the whole sphere.
+    #[cfg(feature = "std")]
+    #[test]
+    fn photons_in_batches_are_the_photons_one_at_a_time() {
+        let s = scene(&[
+            (Vec3::new(0.0, -5.0, 0.0), 1.0),
+            (Vec3::new(0.8, -5.0, 0.0), 1.0),
+            (Vec3::new(3.0, 1.0, -4.0), 0.5),
+        ]);
+        let light = PointLight::new(Vec3::ZERO, Rgb::new(1.0, 2.0, 3.0)).unwrap();
+        let cones = Emission::plan(&s, &light, 3001, false);
+        assert!(matches!(&cones, Emission::Cones(c) if c.len() == 3));
+        for plan in [cones, Emission::Sphere { count: 3001 }] {
+            let n = plan.count();
+            for first in (0..n).step_by(LANES).chain(997..1013).chain(n - 3..n) {
+                let batch = plan.photons::<LANES>(&light, first, (0.3, 0.6));
+                for (k, got) in batch.iter().enumerate() {
+                    let i = first + k as u32;
+                    if i >= n {
+                        continue;
+                    }
+                    let want = plan.photon(&light, i, (0.3, 0.6));
+                    let bits = |(d, p, l, c): (UnitVec3, Rgb, u32, usize)| {
+                        let d = d.get();
+                        ([d.x, d.y, d.z, p.r, p.g, p.b].map(f32::to_bits), l, c)
+                    };
+                    assert_eq!(bits(*got), bits(want), "photon {i}");
+                }
+            }
+        }
     }
 
     #[test]
