@@ -498,7 +498,7 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         let photon = half
             .plan
             .photon(&self.scene.lights()[l], i >> 1, half.shift);
-        self.land_from(l, i, photon, f)
+        self.land_from(l, (i, half), photon, f)
     }
 
     /// [`land`](Self::land) for each photon `i` of `range` in turn, handing `f` the
@@ -526,7 +526,8 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 let block = (range.end - i).min(2 * emit::LANES as u32);
                 for j in i..i + block {
                     let photon = first[((j - i) & 1) as usize][((j - i) >> 1) as usize];
-                    self.land_from(l, j, photon, |x| f(j, x))?;
+                    let half = &halves[(j & 1) as usize];
+                    self.land_from(l, (j, half), photon, |x| f(j, x))?;
                 }
                 i += block;
             }
@@ -538,19 +539,16 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
         Ok(())
     }
 
-    /// Traces photon `i` of light `l` leaving the light as `photon` says (direction,
-    /// power, index in its cone's point set, cone), handing `f` what it leaves.
+    /// Traces photon `i` of light `l`, of `half` of its plan, leaving the light as
+    /// `photon` says (direction, power, index in its cone's point set, cone), handing
+    /// `f` what it leaves.
     fn land_from<E>(
         &self,
         l: usize,
-        i: u32,
+        (i, half): (u32, &Half<O>),
         (dir, power, index, cone): (UnitVec3, Rgb, u32, usize),
         mut f: impl FnMut(Landed) -> Result<(), E>,
     ) -> Result<(), E> {
-        let Some(halves) = self.plans.get(l) else {
-            return Ok(());
-        };
-        let half = &halves[(i & 1) as usize];
         let light = &self.scene.lights()[l];
         let power = power * half.share;
         let mut rng = PathSampler::new(
