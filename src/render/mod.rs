@@ -74,6 +74,7 @@ use differential::{Bend, Bounds, Trail};
 mod cells;
 mod differential;
 mod estimate;
+mod grid;
 mod pixels;
 
 pub use estimate::{ErrorTally, PixelEstimate};
