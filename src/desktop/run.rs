@@ -176,6 +176,9 @@ impl<S> Timed<'_, S> {
     }
 }
 
+// Every method forwarded, none left to the trait's default: a default would answer
+// for the inner store silently (a pixel-centre gather in place of its footprint's).
+#[deny(clippy::missing_trait_methods)]
 impl<S: CausticStore> CausticStore for Timed<'_, S> {
     fn reads_direct(&self) -> bool {
         self.inner.reads_direct()
