@@ -2,7 +2,7 @@
 //! over them in emission order, and the two ways of keeping what it stores
 //! ([`for_each_photon`], [`shoot_with_splats`]).
 
-use super::emit::{self, Emission};
+use super::emit::Emission;
 use super::{reach, splat, trace, Photon, PhotonSettings, Splat, SplatStorage, THINNING};
 use crate::error::{within, Error};
 use crate::geometry::Ray;
@@ -215,9 +215,10 @@ impl<'a, const O: usize, const L: usize> Emitter<'a, O, L> {
                 // Photons i, i + 2, … of one half are consecutive points of its set.
                 let first = [i, i + 1].map(|j| {
                     let h = &halves[(j & 1) as usize];
-                    h.plan.photons::<{ emit::LANES }>(light, j >> 1, h.shift)
+                    h.plan
+                        .photons::<{ super::emit::LANES }>(light, j >> 1, h.shift)
                 });
-                let block = (range.end - i).min(2 * emit::LANES as u32);
+                let block = (range.end - i).min(2 * super::emit::LANES as u32);
                 for j in i..i + block {
                     let photon = first[((j - i) & 1) as usize][((j - i) >> 1) as usize];
                     let half = &halves[(j & 1) as usize];
