@@ -76,6 +76,7 @@ mod differential;
 mod estimate;
 mod grid;
 mod pixels;
+mod probe;
 
 pub use estimate::{ErrorTally, PixelEstimate};
 pub use pixels::{
